@@ -1,0 +1,7 @@
+//! Strapdown inertial navigation: the nominal navigation state, IMU samples, the
+//! mechanization in the local-level ENU frame, and the error-state definition.
+
+pub mod error_state;
+mod nav_state;
+
+pub use nav_state::{ImuSample, NavState};

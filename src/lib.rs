@@ -1,0 +1,20 @@
+//! # adaptive_gnss_ins
+//!
+//! A tightly-coupled IMU + raw GNSS (pseudo-range and pseudo-range rate) error-state
+//! Kalman filter whose noise covariances adapt online, packaged as a ROS 2 Jazzy node.
+//!
+//! ## Frames and conventions
+//! - Navigation frame n: local-level East-North-Up (REP-103; the ERMAKF paper's n-frame,
+//!   V_x east, V_y north, V_z up).
+//! - Body frame b: Forward-Left-Up (REP-103). IMU samples are specific force (REP-145).
+//! - Attitude `q_nb` rotates body vectors into ENU: v^n = C_b^n v^b.
+//! - Positions are geodetic WGS84 (radians, metres above the ellipsoid) inside; ECEF for
+//!   the GNSS geometry; Odometry uses a local ENU tangent frame at a datum.
+//! - SI units and radians everywhere inside; any other unit is in the name.
+//!
+//! ## Layers
+//! The core (`earth`, `ins`, `gnss`, `filter`, `engine`, `config`) does no I/O, reads no
+//! clock and knows nothing of ROS; `ros` converts messages and wires the node.
+
+pub mod earth;
+pub mod ins;
