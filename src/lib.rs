@@ -17,4 +17,5 @@
 //! clock and knows nothing of ROS; `ros` converts messages and wires the node.
 
 pub mod earth;
+pub mod gnss;
 pub mod ins;

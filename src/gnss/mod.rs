@@ -1,0 +1,6 @@
+//! GNSS side of the core: satellite observations as the engine receives them, and the
+//! measurement models (predicted pseudo-range and rate, atmosphere, single-point solution).
+
+mod observation;
+
+pub use observation::{Constellation, GnssEpoch, Klobuchar, SatId, SatObservation};
