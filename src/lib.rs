@@ -17,5 +17,6 @@
 //! clock and knows nothing of ROS; `ros` converts messages and wires the node.
 
 pub mod earth;
+pub mod filter;
 pub mod gnss;
 pub mod ins;

@@ -1,0 +1,146 @@
+//! The standard EKF steps of the ERMAKF paper, eqs. (10)–(11), for the closed-loop error
+//! state: the prior error estimate is zero after every feedback, so the update is
+//! δx̂ = K y with y the innovation (predicted minus measured).
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::ins::error_state::{StateMatrix, StateVector, N};
+
+/// Failures of a Kalman step; the state is left untouched when one is returned.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FilterError {
+    #[error("innovation covariance is not positive definite ({rows} measurements)")]
+    SingularInnovationCovariance { rows: usize },
+    #[error(
+        "measurement dimensions disagree: H {h_rows}x{h_cols}, y {y_len}, R {r_rows}x{r_cols}"
+    )]
+    DimensionMismatch {
+        h_rows: usize,
+        h_cols: usize,
+        y_len: usize,
+        r_rows: usize,
+        r_cols: usize,
+    },
+    #[error("the update produced a non-finite state or covariance")]
+    NonFinite,
+}
+
+/// Time update of the covariance, eq. (10): P⁻ = Φ P Φᵀ + Q_d, symmetrized.
+pub fn propagate_covariance(p: &StateMatrix, phi: &StateMatrix, q_d: &StateMatrix) -> StateMatrix {
+    let p_new = phi * p * phi.transpose() + q_d;
+    symmetrize(&p_new)
+}
+
+/// (A + Aᵀ)/2.
+pub fn symmetrize(p: &StateMatrix) -> StateMatrix {
+    (p + p.transpose()) * 0.5
+}
+
+/// The result of a measurement update.
+#[derive(Debug, Clone)]
+pub struct Update {
+    /// Error-state estimate δx̂ = K y.
+    pub dx: StateVector,
+    /// Posterior covariance.
+    pub p: StateMatrix,
+    /// Innovation covariance S = H P⁻ Hᵀ + R.
+    pub s: DMatrix<f64>,
+    /// Normalized innovation squared yᵀ S⁻¹ y.
+    pub nis: f64,
+}
+
+/// Measurement update, eq. (11), with the innovation `y` (m), rows `h` (m × N) and noise
+/// covariance `r` (m × m).
+///
+/// Math note: the covariance uses Joseph's form (I − KH) P (I − KH)ᵀ + K R Kᵀ when `joseph`
+/// is set, which stays symmetric positive semi-definite for any gain; the short form
+/// (I − KH) P of eq. (11) is kept as an option for comparison with the paper. K is formed
+/// by a Cholesky solve with S, never an explicit inverse.
+pub fn update(
+    p: &StateMatrix,
+    h: &DMatrix<f64>,
+    y: &DVector<f64>,
+    r: &DMatrix<f64>,
+    joseph: bool,
+) -> Result<Update, FilterError> {
+    let m = y.len();
+    if h.nrows() != m || h.ncols() != N || r.nrows() != m || r.ncols() != m {
+        return Err(FilterError::DimensionMismatch {
+            h_rows: h.nrows(),
+            h_cols: h.ncols(),
+            y_len: m,
+            r_rows: r.nrows(),
+            r_cols: r.ncols(),
+        });
+    }
+    let p_dyn = DMatrix::from_column_slice(N, N, p.as_slice());
+    let pht = &p_dyn * h.transpose();
+    let mut s = h * &pht + r;
+    s = (&s + s.transpose()) * 0.5;
+    let chol = s
+        .clone()
+        .cholesky()
+        .ok_or(FilterError::SingularInnovationCovariance { rows: m })?;
+    // K = P Hᵀ S⁻¹  ⇔  S Kᵀ = H P.
+    let k = chol.solve(&pht.transpose()).transpose();
+    let dx_dyn = &k * y;
+    let nis = y.dot(&chol.solve(y));
+    let i_kh = DMatrix::<f64>::identity(N, N) - &k * h;
+    let p_post = if joseph {
+        &i_kh * &p_dyn * i_kh.transpose() + &k * r * k.transpose()
+    } else {
+        &i_kh * &p_dyn
+    };
+    let p_post = StateMatrix::from_column_slice(p_post.as_slice());
+    let p_post = symmetrize(&p_post);
+    let dx = StateVector::from_column_slice(dx_dyn.as_slice());
+    if !(dx.iter().all(|v| v.is_finite())
+        && p_post.iter().all(|v| v.is_finite())
+        && nis.is_finite())
+    {
+        return Err(FilterError::NonFinite);
+    }
+    Ok(Update {
+        dx,
+        p: p_post,
+        s,
+        nis,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scalar_update_matches_closed_form() {
+        let mut p = StateMatrix::identity() * 4.0;
+        p[(0, 1)] = 1.0;
+        p[(1, 0)] = 1.0;
+        let mut h = DMatrix::zeros(1, N);
+        h[(0, 0)] = 1.0;
+        let y = DVector::from_element(1, 2.0);
+        let r = DMatrix::from_element(1, 1, 1.0);
+        for joseph in [true, false] {
+            let u = update(&p, &h, &y, &r, joseph).unwrap();
+            // S = 5, K = [4, 1, 0...]/5
+            assert!((u.dx[0] - 1.6).abs() < 1e-12);
+            assert!((u.dx[1] - 0.4).abs() < 1e-12);
+            assert!((u.p[(0, 0)] - 0.8).abs() < 1e-12);
+            assert!((u.p[(1, 1)] - (4.0 - 0.2)).abs() < 1e-12);
+            assert!((u.nis - 0.8).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn rejects_singular_innovation_covariance() {
+        let p = StateMatrix::zeros();
+        let h = DMatrix::zeros(2, N);
+        let y = DVector::zeros(2);
+        let r = DMatrix::zeros(2, 2);
+        assert!(matches!(
+            update(&p, &h, &y, &r, true),
+            Err(FilterError::SingularInnovationCovariance { rows: 2 })
+        ));
+    }
+}
