@@ -4,5 +4,6 @@
 pub mod atmosphere;
 pub mod geometry;
 mod observation;
+pub mod spp;
 
 pub use observation::{Constellation, GnssEpoch, Klobuchar, SatId, SatObservation};
