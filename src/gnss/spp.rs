@@ -246,6 +246,8 @@ struct Row {
     residual: f64,
     sigma: f64,
     elevation_rad: Option<f64>,
+    /// Elevation used for the σ model (None away from the surface).
+    weighting_elevation_rad: Option<f64>,
     /// Full prediction when the iterate has geodetic coordinates.
     prediction: Option<SatPrediction>,
 }
@@ -451,6 +453,7 @@ fn evaluate(
             residual: obs.pseudorange_m - predicted,
             sigma: config.sigma.pseudorange_sigma_m(obs, weighting_elevation),
             elevation_rad,
+            weighting_elevation_rad: weighting_elevation,
             prediction,
         });
     }
@@ -547,7 +550,7 @@ fn solve_velocity(
         let residual = rate - p.pseudorange_rate_mps;
         let sigma = config
             .sigma
-            .pseudorange_rate_sigma_mps(obs, row.elevation_rad);
+            .pseudorange_rate_sigma_mps(obs, row.weighting_elevation_rad);
         rate_rows.push((Vector4::new(d[0], d[1], d[2], 1.0), residual, sigma));
         sats.push(obs.sat);
     }
