@@ -20,3 +20,4 @@ pub mod earth;
 pub mod filter;
 pub mod gnss;
 pub mod ins;
+pub mod sim;

@@ -1,6 +1,9 @@
 //! GNSS side of the core: satellite observations as the engine receives them, and the
 //! measurement models (predicted pseudo-range and rate, atmosphere, single-point solution).
 
+pub mod atmosphere;
+pub mod geometry;
 mod observation;
+pub mod spp;
 
 pub use observation::{Constellation, GnssEpoch, Klobuchar, SatId, SatObservation};
