@@ -2,8 +2,10 @@ use nalgebra::{UnitQuaternion, Vector3};
 
 use crate::earth::Llh;
 
-/// One IMU sample in REP-145 form, already rotated into the body frame (FLU):
-/// angular rate ω_ib^b (rad/s) and specific force f_ib^b (m/s², gravity included).
+/// One IMU sample in REP-145 form: angular rate ω_ib (rad/s) and specific force f_ib
+/// (m/s², gravity included). The engine receives samples in the IMU's own axes and rotates
+/// them into the body frame (FLU) with the configured mounting; from there on the fields
+/// hold body-frame vectors.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ImuSample {
     /// Sample time (s) on the engine's time axis.

@@ -1,0 +1,133 @@
+//! The running filter: nominal state, sensor and clock error estimates, covariance; the
+//! IMU propagation step and the closed-loop feedback of an error-state estimate.
+
+use nalgebra::{UnitQuaternion, Vector3};
+
+use crate::filter::ekf;
+use crate::filter::process_model::{self, LinearizationPoint, ProcessNoise};
+use crate::ins::error_state::{
+    StateMatrix, StateVector, ACC_BIAS, CLOCK_BIAS, CLOCK_DRIFT, DP, DV, GYRO_BIAS, GYRO_GM, PHI,
+};
+use crate::ins::mechanization::{self, ImuIncrement, MechanizationError};
+use crate::ins::{ImuSample, NavState};
+
+use super::output::Solution;
+
+/// Filter state between IMU samples.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FilterState {
+    pub nav: NavState,
+    /// Gyro constant bias estimate ε_b (rad/s).
+    pub gyro_bias_rad_s: Vector3<f64>,
+    /// Gyro Gauss-Markov drift estimate ε_r (rad/s).
+    pub gyro_markov_rad_s: Vector3<f64>,
+    /// Accelerometer Gauss-Markov bias estimate ∇ (m/s²).
+    pub accel_bias_m_s2: Vector3<f64>,
+    pub clock_bias_m: f64,
+    pub clock_drift_mps: f64,
+    pub p: StateMatrix,
+    /// The previous IMU increment (for the coning and sculling corrections).
+    pub prev_increment: Option<ImuIncrement>,
+    /// The last body-frame IMU sample the state was propagated to (raw, uncompensated).
+    pub last_imu: ImuSample,
+}
+
+impl FilterState {
+    /// Removes the estimated sensor errors from a raw body-frame sample.
+    pub fn compensate(&self, raw: &ImuSample) -> ImuSample {
+        ImuSample {
+            t_s: raw.t_s,
+            w_ib_b_rad_s: raw.w_ib_b_rad_s - self.gyro_bias_rad_s - self.gyro_markov_rad_s,
+            f_ib_b_m_s2: raw.f_ib_b_m_s2 - self.accel_bias_m_s2,
+        }
+    }
+
+    /// Propagates the nominal state and the covariance to the raw sample `next`.
+    pub fn propagate(
+        &mut self,
+        next: &ImuSample,
+        noise: &ProcessNoise,
+    ) -> Result<(), MechanizationError> {
+        let prev = self.compensate(&self.last_imu);
+        let cur = self.compensate(next);
+        let increment = ImuIncrement::from_samples(&prev, &cur)?;
+        let dt = increment.dt_s;
+        let nav = mechanization::integrate(&self.nav, self.prev_increment.as_ref(), &increment)?;
+        // Linearize at the start of the interval with the interval's mean specific force.
+        let lin = LinearizationPoint {
+            nav: self.nav,
+            f_ib_b_m_s2: increment.dv_b_m_s / dt,
+        };
+        let f = process_model::system_matrix(&lin, noise);
+        let (phi, q_d) = process_model::discretize(&f, &process_model::noise_density(noise), dt);
+        self.p = ekf::propagate_covariance(&self.p, &phi, &q_d);
+        self.nav = nav;
+        // The nominal Gauss-Markov and clock states follow their expected dynamics.
+        self.gyro_markov_rad_s *= (-dt / noise.gyro_markov_time_s).exp();
+        self.accel_bias_m_s2 *= (-dt / noise.accel_markov_time_s).exp();
+        self.clock_bias_m += self.clock_drift_mps * dt;
+        self.clock_drift_mps *= (-dt / noise.clock_drift_time_s).exp();
+        self.prev_increment = Some(increment);
+        self.last_imu = *next;
+        Ok(())
+    }
+
+    /// Closed-loop feedback of the error estimate δx̂ (see [`crate::ins::error_state`] for
+    /// the sign conventions); afterwards the error state is zero again.
+    ///
+    /// Math note: the reset Jacobian of the attitude error, I − ½[δφ×], differs from the
+    /// identity by the size of the correction (milliradians); it is neglected, as usual.
+    pub fn apply_correction(&mut self, dx: &StateVector) {
+        let phi = Vector3::new(dx[PHI], dx[PHI + 1], dx[PHI + 2]);
+        self.nav.q_nb = UnitQuaternion::from_scaled_axis(phi) * self.nav.q_nb;
+        self.nav.v_n -= dx.fixed_rows::<3>(DV);
+        self.nav.p.lat_rad -= dx[DP];
+        self.nav.p.lon_rad -= dx[DP + 1];
+        self.nav.p.height_m -= dx[DP + 2];
+        self.gyro_bias_rad_s += dx.fixed_rows::<3>(GYRO_BIAS);
+        self.gyro_markov_rad_s += dx.fixed_rows::<3>(GYRO_GM);
+        self.accel_bias_m_s2 += dx.fixed_rows::<3>(ACC_BIAS);
+        self.clock_bias_m -= dx[CLOCK_BIAS];
+        self.clock_drift_mps -= dx[CLOCK_DRIFT];
+    }
+
+    /// True when every number of the state is finite.
+    pub fn is_finite(&self) -> bool {
+        self.nav.is_finite()
+            && self.gyro_bias_rad_s.iter().all(|v| v.is_finite())
+            && self.gyro_markov_rad_s.iter().all(|v| v.is_finite())
+            && self.accel_bias_m_s2.iter().all(|v| v.is_finite())
+            && self.clock_bias_m.is_finite()
+            && self.clock_drift_mps.is_finite()
+            && self.p.iter().all(|v| v.is_finite())
+    }
+
+    /// The solution at the current time.
+    pub fn solution(&self) -> Solution {
+        let compensated = self.compensate(&self.last_imu);
+        Solution {
+            nav: self.nav,
+            covariance: self.p,
+            gyro_bias_rad_s: self.gyro_bias_rad_s + self.gyro_markov_rad_s,
+            accel_bias_m_s2: self.accel_bias_m_s2,
+            clock_bias_m: self.clock_bias_m,
+            clock_drift_mps: self.clock_drift_mps,
+            angular_rate_b_rad_s: compensated.w_ib_b_rad_s,
+        }
+    }
+}
+
+/// Linear interpolation of two IMU samples at `t_s` (within [a.t_s, b.t_s]).
+pub fn interpolate(a: &ImuSample, b: &ImuSample, t_s: f64) -> ImuSample {
+    let span = b.t_s - a.t_s;
+    let w = if span > 0.0 {
+        ((t_s - a.t_s) / span).clamp(0.0, 1.0)
+    } else {
+        1.0
+    };
+    ImuSample {
+        t_s,
+        w_ib_b_rad_s: a.w_ib_b_rad_s.lerp(&b.w_ib_b_rad_s, w),
+        f_ib_b_m_s2: a.f_ib_b_m_s2.lerp(&b.f_ib_b_m_s2, w),
+    }
+}

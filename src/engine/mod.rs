@@ -1,0 +1,421 @@
+//! The engine: owns time, buffers the IMU, aligns GNSS measurements to their epoch,
+//! initializes, propagates and updates the filter, and reports. It never reads a clock:
+//! time comes in with the data, so replay is exact and deterministic. The live node,
+//! offline replay and the tests all drive this one type.
+//!
+//! Time handling:
+//! - IMU samples must arrive with strictly increasing stamps; a duplicate or an older one
+//!   is rejected and counted. A gap longer than `engine.max_imu_gap_s` resets the filter
+//!   (nothing can be integrated across it) and it starts again from the next position.
+//! - A GNSS measurement newer than the last IMU sample waits until the IMU reaches it; the
+//!   state is then propagated to its exact time with an interpolated IMU sample, updated,
+//!   and propagated on.
+//! - A measurement older than the last IMU sample (late delivery) rolls the filter back to
+//!   the last stored state before it, applies it, and re-integrates the buffered IMU
+//!   samples; one older than `engine.imu_buffer_s` is rejected and counted.
+
+mod filter_state;
+mod initializer;
+mod loose_update;
+mod output;
+mod rejection;
+mod tight_update;
+
+use std::collections::VecDeque;
+
+use crate::config::{Config, Coupling};
+use crate::filter::process_model::ProcessNoise;
+use crate::gnss::GnssEpoch;
+use crate::ins::ImuSample;
+
+pub use filter_state::FilterState;
+pub use initializer::{InitPhase, Initializer};
+pub use loose_update::GnssFix;
+pub use output::{
+    EpochReport, MeasurementKind, Output, ResetReason, SatRejection, SatReport, Solution,
+    StatusEvent,
+};
+pub use rejection::{InputRejected, RejectionCounters, RejectionReason};
+
+use filter_state::interpolate;
+
+/// A measurement waiting for its time.
+#[derive(Debug, Clone, PartialEq)]
+enum Measurement {
+    Gnss(GnssEpoch),
+    Fix(GnssFix),
+}
+
+impl Measurement {
+    fn t_s(&self) -> f64 {
+        match self {
+            Self::Gnss(e) => e.t_s,
+            Self::Fix(f) => f.t_s,
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq)]
+struct Pending {
+    measurement: Measurement,
+    /// Already reported once (re-applied after a roll-back): report it silently.
+    reported: bool,
+}
+
+/// The filter state after one IMU sample, with the measurements applied in that step.
+#[derive(Debug, Clone)]
+struct Snapshot {
+    state: FilterState,
+    applied: Vec<Measurement>,
+}
+
+#[derive(Debug, Clone)]
+enum Phase {
+    Initializing(Initializer),
+    Running(Box<FilterState>),
+}
+
+/// The navigation engine. See the module documentation.
+#[derive(Debug, Clone)]
+pub struct Engine {
+    config: Config,
+    noise: ProcessNoise,
+    phase: Phase,
+    /// Raw body-frame IMU samples of the last `imu_buffer_s`.
+    imu: VecDeque<ImuSample>,
+    /// Filter states after each of the buffered IMU samples (while running).
+    history: VecDeque<Snapshot>,
+    pending: Vec<Pending>,
+    last_output_t_s: f64,
+    counters: RejectionCounters,
+    /// Reports are suppressed while re-integrating after a roll-back.
+    replaying: bool,
+}
+
+impl Engine {
+    pub fn new(config: Config) -> Self {
+        let noise = process_noise(&config);
+        Self {
+            config,
+            noise,
+            phase: Phase::Initializing(Initializer::default()),
+            imu: VecDeque::new(),
+            history: VecDeque::new(),
+            pending: Vec::new(),
+            last_output_t_s: f64::NEG_INFINITY,
+            counters: RejectionCounters::default(),
+            replaying: false,
+        }
+    }
+
+    pub fn config(&self) -> &Config {
+        &self.config
+    }
+
+    /// Inputs rejected so far, by reason.
+    pub fn counters(&self) -> &RejectionCounters {
+        &self.counters
+    }
+
+    /// The running filter state, or None while initializing.
+    pub fn state(&self) -> Option<&FilterState> {
+        match &self.phase {
+            Phase::Running(s) => Some(s),
+            Phase::Initializing(_) => None,
+        }
+    }
+
+    /// The start-up phase, or None once running.
+    pub fn init_phase(&self) -> Option<InitPhase> {
+        match &self.phase {
+            Phase::Initializing(init) => Some(init.phase()),
+            Phase::Running(_) => None,
+        }
+    }
+
+    /// Time of the last accepted IMU sample.
+    pub fn last_imu_t_s(&self) -> Option<f64> {
+        self.imu.back().map(|s| s.t_s)
+    }
+
+    /// The configured filter variant's name.
+    pub fn variant_name(&self) -> &'static str {
+        self.config.filter.variant.name()
+    }
+
+    /// Forgets everything (as after a time jump backwards) and starts again; the attitude
+    /// learned so far is kept when the filter was running.
+    pub fn reset(&mut self, t_s: f64, reason: ResetReason) -> Output {
+        let init = match &self.phase {
+            Phase::Running(s) => Initializer::with_attitude(
+                s.nav.q_nb,
+                s.gyro_bias_rad_s + s.gyro_markov_rad_s,
+                s.last_imu.t_s,
+            ),
+            Phase::Initializing(_) => Initializer::default(),
+        };
+        self.phase = Phase::Initializing(init);
+        self.imu.clear();
+        self.history.clear();
+        self.pending.clear();
+        self.last_output_t_s = f64::NEG_INFINITY;
+        Output::Status(StatusEvent::Reset { t_s, reason })
+    }
+
+    /// Feeds one IMU sample in the IMU's own axes.
+    pub fn push_imu(&mut self, sample: &ImuSample) -> Result<Vec<Output>, InputRejected> {
+        let body = ImuSample {
+            t_s: sample.t_s,
+            w_ib_b_rad_s: self.config.mounting.imu_to_body * sample.w_ib_b_rad_s,
+            f_ib_b_m_s2: self.config.mounting.imu_to_body * sample.f_ib_b_m_s2,
+        };
+        if !body.is_finite() {
+            return Err(self.counters.reject(RejectionReason::ImuNotFinite, sample.t_s));
+        }
+        let mut out = Vec::new();
+        if let Some(last) = self.imu.back() {
+            let dt = body.t_s - last.t_s;
+            if dt == 0.0 {
+                return Err(self.counters.reject(RejectionReason::ImuDuplicate, body.t_s));
+            }
+            if dt < 0.0 {
+                return Err(self.counters.reject(RejectionReason::ImuOutOfOrder, body.t_s));
+            }
+            if dt > self.config.engine.max_imu_gap_s {
+                self.counters.reject(RejectionReason::ImuGap, body.t_s);
+                out.push(self.reset(body.t_s, ResetReason::ImuGap));
+            }
+        }
+        self.imu.push_back(body);
+        let horizon = body.t_s - self.config.engine.imu_buffer_s;
+        while self.imu.front().is_some_and(|s| s.t_s < horizon) && self.imu.len() > 2 {
+            self.imu.pop_front();
+        }
+        while self.history.front().is_some_and(|s| s.state.last_imu.t_s < horizon) {
+            self.history.pop_front();
+        }
+        self.advance(&body, &mut out);
+        Ok(out)
+    }
+
+    /// Feeds one GNSS epoch (tightly coupled).
+    pub fn push_gnss(&mut self, epoch: GnssEpoch) -> Result<Vec<Output>, InputRejected> {
+        if !epoch.t_s.is_finite() || !epoch.gps_time_of_week_s.is_finite() {
+            return Err(self.counters.reject(RejectionReason::GnssNotFinite, epoch.t_s));
+        }
+        if epoch.satellites.is_empty() {
+            return Err(self.counters.reject(RejectionReason::GnssNoSatellites, epoch.t_s));
+        }
+        if self.config.filter.coupling != Coupling::Tight {
+            return Err(self.counters.reject(RejectionReason::WrongCoupling, epoch.t_s));
+        }
+        self.push_measurement(Measurement::Gnss(epoch))
+    }
+
+    /// Feeds one receiver fix (loosely coupled).
+    pub fn push_fix(&mut self, fix: GnssFix) -> Result<Vec<Output>, InputRejected> {
+        if !fix.is_finite() {
+            return Err(self.counters.reject(RejectionReason::FixNotFinite, fix.t_s));
+        }
+        if self.config.filter.coupling != Coupling::Loose {
+            return Err(self.counters.reject(RejectionReason::WrongCoupling, fix.t_s));
+        }
+        self.push_measurement(Measurement::Fix(fix))
+    }
+
+    fn push_measurement(&mut self, m: Measurement) -> Result<Vec<Output>, InputRejected> {
+        let t = m.t_s();
+        let Some(last_t) = self.last_imu_t_s() else {
+            // Nothing to align it with yet: it waits for the IMU.
+            self.enqueue(m, false);
+            return Ok(Vec::new());
+        };
+        if self.pending.iter().any(|p| p.measurement.t_s() == t)
+            || self.history.iter().any(|s| s.applied.iter().any(|a| a.t_s() == t))
+        {
+            return Err(self.counters.reject(RejectionReason::MeasurementDuplicate, t));
+        }
+        if t > last_t {
+            self.enqueue(m, false);
+            return Ok(Vec::new());
+        }
+        let oldest = self.imu.front().map_or(last_t, |s| s.t_s);
+        if t < oldest {
+            return Err(self.counters.reject(RejectionReason::MeasurementTooOld, t));
+        }
+        let mut out = Vec::new();
+        match &self.phase {
+            Phase::Initializing(_) => {
+                // Start-up needs no exact alignment: try it now, then re-integrate.
+                self.enqueue(m, false);
+                self.replay_from(None, &mut out);
+            }
+            Phase::Running(_) => {
+                // Roll back to the last state at or before t.
+                let keep = self.history.iter().rposition(|s| s.state.last_imu.t_s <= t);
+                match keep {
+                    Some(k) => {
+                        self.enqueue(m, false);
+                        let undone: Vec<Snapshot> = self.history.drain(k + 1..).collect();
+                        for snap in undone {
+                            for a in snap.applied {
+                                self.enqueue(a, true);
+                            }
+                        }
+                        let start = self.history.back().map(|s| s.state.clone());
+                        self.replay_from(start, &mut out);
+                    }
+                    None => {
+                        return Err(self.counters.reject(RejectionReason::MeasurementTooOld, t));
+                    }
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    fn enqueue(&mut self, measurement: Measurement, reported: bool) {
+        let t = measurement.t_s();
+        let at = self.pending.partition_point(|p| p.measurement.t_s() <= t);
+        self.pending.insert(at, Pending { measurement, reported });
+    }
+
+    /// Re-integrates the buffered IMU samples after `start` (or all of them when the
+    /// filter is initializing), applying the pending measurements on the way.
+    fn replay_from(&mut self, start: Option<FilterState>, out: &mut Vec<Output>) {
+        let from_t = start.as_ref().map_or(f64::NEG_INFINITY, |s| s.last_imu.t_s);
+        if let Some(state) = start {
+            self.phase = Phase::Running(Box::new(state));
+        }
+        let samples: Vec<ImuSample> = self.imu.iter().filter(|s| s.t_s > from_t).copied().collect();
+        let last_t = samples.last().map(|s| s.t_s);
+        self.replaying = true;
+        for s in &samples {
+            if Some(s.t_s) == last_t {
+                self.replaying = false;
+            }
+            self.advance(s, out);
+        }
+        self.replaying = false;
+    }
+
+    /// Processes everything up to the body-frame sample `s` (already buffered).
+    fn advance(&mut self, s: &ImuSample, out: &mut Vec<Output>) {
+        let mut applied = Vec::new();
+        while self.pending.first().is_some_and(|p| p.measurement.t_s() <= s.t_s) {
+            let p = self.pending.remove(0);
+            self.apply_measurement(&p, s, out);
+            applied.push(p.measurement);
+        }
+        match &mut self.phase {
+            Phase::Initializing(init) => init.push_imu(s, &self.config),
+            Phase::Running(state) => {
+                if state.last_imu.t_s < s.t_s {
+                    if let Err(e) = state.propagate(s, &self.noise) {
+                        log::warn!("IMU step to t = {:.6} s failed: {e}", s.t_s);
+                        self.counters.reject(RejectionReason::ImuStepFailed, s.t_s);
+                        let reset = self.reset(s.t_s, ResetReason::Diverged);
+                        out.push(reset);
+                        return;
+                    }
+                }
+                let state = state.as_ref().clone();
+                self.emit_solution(&state, out);
+                self.history.push_back(Snapshot { state, applied });
+            }
+        }
+    }
+
+    /// Propagates to the measurement's time (running) or tries to start (initializing),
+    /// then applies it.
+    fn apply_measurement(&mut self, p: &Pending, next: &ImuSample, out: &mut Vec<Output>) {
+        let t = p.measurement.t_s();
+        let report = !self.replaying && !p.reported;
+        match &mut self.phase {
+            Phase::Initializing(init) => {
+                let started = match &p.measurement {
+                    Measurement::Gnss(e) => init.try_gnss(e, &self.config),
+                    Measurement::Fix(f) => init.try_fix(f, &self.config),
+                };
+                if let Some(initial) = started {
+                    let before = self.imu.iter().rev().find(|s| s.t_s <= t).copied().unwrap_or(*next);
+                    let last_imu = interpolate(&before, next, t);
+                    let state = FilterState {
+                        nav: initial.nav,
+                        gyro_bias_rad_s: initial.gyro_bias_rad_s,
+                        gyro_markov_rad_s: nalgebra::Vector3::zeros(),
+                        accel_bias_m_s2: nalgebra::Vector3::zeros(),
+                        clock_bias_m: initial.clock_bias_m,
+                        clock_drift_mps: initial.clock_drift_mps,
+                        p: initial.p,
+                        prev_increment: None,
+                        last_imu,
+                    };
+                    self.phase = Phase::Running(Box::new(state));
+                    if report {
+                        out.push(Output::Status(StatusEvent::Initialized {
+                            t_s: t,
+                            heading_from_motion: initial.heading_from_motion,
+                        }));
+                    }
+                }
+            }
+            Phase::Running(state) => {
+                if state.last_imu.t_s < t {
+                    let at_t = interpolate(&state.last_imu, next, t);
+                    if let Err(e) = state.propagate(&at_t, &self.noise) {
+                        log::warn!("IMU step to the measurement at t = {t:.6} s failed: {e}");
+                        self.counters.reject(RejectionReason::ImuStepFailed, t);
+                        return;
+                    }
+                }
+                let w = state.compensate(&state.last_imu).w_ib_b_rad_s;
+                let variant = self.config.filter.variant.name();
+                let before = state.as_ref().clone();
+                let result = match &p.measurement {
+                    Measurement::Gnss(e) => tight_update::update(state, e, &w, &self.config, variant),
+                    Measurement::Fix(f) => loose_update::update(state, f, &w, &self.config, variant),
+                };
+                match result {
+                    Ok(epoch) if state.is_finite() => {
+                        if report {
+                            out.push(Output::Epoch(epoch));
+                        }
+                    }
+                    Ok(_) | Err(_) => {
+                        **state = before;
+                        self.counters.reject(RejectionReason::UpdateFailed, t);
+                    }
+                }
+            }
+        }
+    }
+
+    fn emit_solution(&mut self, state: &FilterState, out: &mut Vec<Output>) {
+        if self.replaying {
+            return;
+        }
+        let t = state.last_imu.t_s;
+        let rate = self.config.output.rate_hz;
+        if rate > 0.0 && t - self.last_output_t_s < 1.0 / rate - 1e-9 {
+            return;
+        }
+        self.last_output_t_s = t;
+        out.push(Output::Solution(Box::new(state.solution())));
+    }
+}
+
+/// The process noise of the configuration.
+fn process_noise(config: &Config) -> ProcessNoise {
+    ProcessNoise {
+        gyro_arw_rad_per_sqrt_s: config.imu.gyro_arw_rad_per_sqrt_s,
+        gyro_markov_sigma_rad_s: config.imu.gyro_markov_sigma_rad_s,
+        gyro_markov_time_s: config.imu.gyro_markov_time_s,
+        accel_vrw_m_s_per_sqrt_s: config.imu.accel_vrw_m_s_per_sqrt_s,
+        accel_bias_sigma_m_s2: config.imu.accel_bias_sigma_m_s2,
+        accel_markov_time_s: config.imu.accel_markov_time_s,
+        clock_bias_noise_m_per_sqrt_s: config.clock.bias_noise_m_per_sqrt_s,
+        clock_drift_noise_m_s_per_sqrt_s: config.clock.drift_noise_m_s_per_sqrt_s,
+        clock_drift_time_s: config.clock.drift_time_s,
+    }
+}

@@ -1,0 +1,184 @@
+//! What the engine hands out: navigation solutions, per-epoch measurement reports (the
+//! content of the covariance-diagnostic topic) and status events.
+
+use nalgebra::{Matrix3, SMatrix, Vector3};
+
+use crate::earth;
+use crate::gnss::SatId;
+use crate::ins::error_state::{StateMatrix, DP, DV, PHI};
+use crate::ins::NavState;
+
+/// One navigation solution at an IMU time.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Solution {
+    /// The corrected nominal state (position of the IMU, velocity, attitude).
+    pub nav: NavState,
+    /// Full error-state covariance (units of [`crate::ins::error_state`]).
+    pub covariance: StateMatrix,
+    /// Estimated gyro bias, constant plus Gauss-Markov part, body FLU (rad/s).
+    pub gyro_bias_rad_s: Vector3<f64>,
+    /// Estimated accelerometer bias, body FLU (m/s²).
+    pub accel_bias_m_s2: Vector3<f64>,
+    /// Receiver clock offset c·δt_u (m).
+    pub clock_bias_m: f64,
+    /// Receiver clock drift c·δt_ru (m/s).
+    pub clock_drift_mps: f64,
+    /// Angular rate of the body (bias-compensated), for twist outputs (rad/s).
+    pub angular_rate_b_rad_s: Vector3<f64>,
+}
+
+impl Solution {
+    /// Covariance of (E, N, U) position in metres², from the (δL, δλ, δh) block.
+    pub fn position_covariance_enu_m2(&self) -> Matrix3<f64> {
+        let (north, east) = earth::metres_per_radian(&self.nav.p);
+        // (E, N, U) = T (δL, δλ, δh) with T = [[0, east, 0], [north, 0, 0], [0, 0, 1]].
+        let t = Matrix3::new(0.0, east, 0.0, north, 0.0, 0.0, 0.0, 0.0, 1.0);
+        let block: Matrix3<f64> = self.covariance.fixed_view::<3, 3>(DP, DP).into();
+        t * block * t.transpose()
+    }
+
+    /// Covariance of the ENU velocity ((m/s)²).
+    pub fn velocity_covariance_enu_m2_s2(&self) -> Matrix3<f64> {
+        self.covariance.fixed_view::<3, 3>(DV, DV).into()
+    }
+
+    /// Covariance of the attitude error φ about the E, N, U axes (rad²).
+    pub fn attitude_covariance_rad2(&self) -> Matrix3<f64> {
+        self.covariance.fixed_view::<3, 3>(PHI, PHI).into()
+    }
+
+    /// 6×6 pose covariance (E, N, U, rotation about E, N, U), in the ROS pose order.
+    pub fn pose_covariance_enu(&self) -> SMatrix<f64, 6, 6> {
+        let (north, east) = earth::metres_per_radian(&self.nav.p);
+        let mut t = SMatrix::<f64, 6, 20>::zeros();
+        t[(0, DP + 1)] = east;
+        t[(1, DP)] = north;
+        t[(2, DP + 2)] = 1.0;
+        for i in 0..3 {
+            t[(3 + i, PHI + i)] = 1.0;
+        }
+        t * self.covariance * t.transpose()
+    }
+}
+
+/// Why a satellite's measurement was not used.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum SatRejection {
+    ElevationMask,
+    Cn0Mask,
+    InnovationGate,
+    NotANumber,
+    NoSatelliteState,
+    Mahalanobis,
+    ConstellationDisabled,
+}
+
+impl SatRejection {
+    /// Stable snake_case name, used for counters and diagnostics.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::ElevationMask => "elevation_mask",
+            Self::Cn0Mask => "cn0_mask",
+            Self::InnovationGate => "innovation_gate",
+            Self::NotANumber => "not_a_number",
+            Self::NoSatelliteState => "no_satellite_state",
+            Self::Mahalanobis => "mahalanobis",
+            Self::ConstellationDisabled => "constellation_disabled",
+        }
+    }
+}
+
+/// One satellite's part of an epoch report. NaN marks a value that was not computed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SatReport {
+    pub sat: SatId,
+    pub elevation_rad: f64,
+    /// Pseudo-range used in the update.
+    pub used_pseudorange: bool,
+    /// Pseudo-range rate used in the update.
+    pub used_rate: bool,
+    /// Why the pseudo-range (or, if only that failed, the rate) was left out.
+    pub rejection: Option<SatRejection>,
+    /// Innovation measured − predicted of the pseudo-range (m).
+    pub innovation_pseudorange_m: f64,
+    /// Innovation measured − predicted of the rate (m/s).
+    pub innovation_rate_mps: f64,
+    /// Innovation divided by √(H P Hᵀ + R) of its own row.
+    pub normalized_innovation_pseudorange: f64,
+    pub normalized_innovation_rate: f64,
+    /// Measurement variance used for the pseudo-range (m²).
+    pub r_pseudorange_m2: f64,
+    /// Measurement variance used for the rate ((m/s)²).
+    pub r_rate_m2_s2: f64,
+}
+
+impl SatReport {
+    pub fn new(sat: SatId) -> Self {
+        Self {
+            sat,
+            elevation_rad: f64::NAN,
+            used_pseudorange: false,
+            used_rate: false,
+            rejection: None,
+            innovation_pseudorange_m: f64::NAN,
+            innovation_rate_mps: f64::NAN,
+            normalized_innovation_pseudorange: f64::NAN,
+            normalized_innovation_rate: f64::NAN,
+            r_pseudorange_m2: f64::NAN,
+            r_rate_m2_s2: f64::NAN,
+        }
+    }
+}
+
+/// Kind of measurement an epoch report describes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MeasurementKind {
+    /// Raw pseudo-ranges and rates (tightly coupled).
+    Pseudoranges,
+    /// A position (and optional velocity) fix (loosely coupled).
+    Fix,
+}
+
+/// The diagnostics of one measurement update.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EpochReport {
+    pub t_s: f64,
+    pub kind: MeasurementKind,
+    /// Filter variant name (as in the parameters).
+    pub variant: &'static str,
+    pub satellites: Vec<SatReport>,
+    /// Number of scalar measurements used.
+    pub measurements_used: usize,
+    /// Normalized innovation squared of the update (NaN without an update).
+    pub nis: f64,
+    /// A receiver clock jump absorbed in this epoch (m), 0 if none.
+    pub clock_jump_m: f64,
+}
+
+/// Life-cycle events.
+#[derive(Debug, Clone, PartialEq)]
+pub enum StatusEvent {
+    /// The filter started; `heading_from_motion` tells how the heading was found.
+    Initialized { t_s: f64, heading_from_motion: bool },
+    /// The filter was reset and waits for a new initialization.
+    Reset { t_s: f64, reason: ResetReason },
+}
+
+/// Why the filter was reset.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ResetReason {
+    /// The IMU stream had a gap longer than `engine.max_imu_gap_s`.
+    ImuGap,
+    /// Time went backwards (a bag played in a loop), handled by the caller.
+    TimeJumpBackwards,
+    /// A measurement update produced a non-finite state.
+    Diverged,
+}
+
+/// Everything the engine emits.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Output {
+    Solution(Box<Solution>),
+    Epoch(EpochReport),
+    Status(StatusEvent),
+}

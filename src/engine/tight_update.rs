@@ -1,0 +1,254 @@
+//! The tightly-coupled measurement update of one GNSS epoch: prediction of every
+//! satellite's pseudo-range and rate from the nominal state (eqs. 7–9), screening, clock
+//! jump absorption, innovation gating, the EKF update and the feedback.
+
+use nalgebra::{DMatrix, DVector, Vector3};
+
+use crate::config::Config;
+use crate::filter::ekf::{self, FilterError};
+use crate::filter::measurement_rows::{AntennaGeometry, Row};
+use crate::gnss::geometry::{self, SatPrediction};
+use crate::gnss::spp::SigmaModel;
+use crate::gnss::GnssEpoch;
+
+use super::filter_state::FilterState;
+use super::output::{EpochReport, MeasurementKind, SatRejection, SatReport};
+
+/// One scalar measurement that passed the screening.
+struct Candidate {
+    /// Index into the report's satellites.
+    sat_index: usize,
+    is_rate: bool,
+    row: Row,
+    /// Predicted − measured.
+    y: f64,
+    r: f64,
+}
+
+/// The measurement σ model of the configuration.
+pub fn sigma_model(config: &Config) -> SigmaModel {
+    SigmaModel {
+        pseudorange_zenith_m: config.gnss.pseudorange_sigma_m,
+        pseudorange_rate_zenith_mps: config.gnss.pseudorange_rate_sigma_mps,
+        // Choice: with elevation weighting off, a 90° floor makes σ constant.
+        min_elevation_rad: if config.gnss.elevation_weighting {
+            config.gnss.elevation_mask_rad.max(5f64.to_radians())
+        } else {
+            std::f64::consts::FRAC_PI_2
+        },
+        prefer_reported: config.gnss.use_receiver_sigmas,
+    }
+}
+
+/// Updates `state` with `epoch`; `w_ib_b_rad_s` is the compensated body rate at the epoch
+/// (for the lever-arm velocity). Returns the epoch report; on a filter failure the state
+/// is unchanged and the error is returned.
+pub fn update(
+    state: &mut FilterState,
+    epoch: &GnssEpoch,
+    w_ib_b_rad_s: &Vector3<f64>,
+    config: &Config,
+    variant: &'static str,
+) -> Result<EpochReport, FilterError> {
+    let geo = AntennaGeometry::new(&state.nav, &config.mounting.lever_arm_b_m, w_ib_b_rad_s);
+    let rx_pos = geo.antenna_ecef_m(&state.nav.p);
+    let rx_vel = geo.antenna_velocity_ecef_mps(&state.nav.v_n);
+    let sigmas = sigma_model(config);
+    let mut report = EpochReport {
+        t_s: epoch.t_s,
+        kind: MeasurementKind::Pseudoranges,
+        variant,
+        satellites: Vec::with_capacity(epoch.satellites.len()),
+        measurements_used: 0,
+        nis: f64::NAN,
+        clock_jump_m: 0.0,
+    };
+    let mut candidates = Vec::with_capacity(2 * epoch.satellites.len());
+    for obs in &epoch.satellites {
+        let mut sat = SatReport::new(obs.sat);
+        let prediction = screen(obs, &rx_pos, &rx_vel, state, epoch, config);
+        match prediction {
+            Err(reason) => sat.rejection = Some(reason),
+            Ok(pred) => {
+                sat.elevation_rad = pred.elevation_rad;
+                let index = report.satellites.len();
+                let el = Some(pred.elevation_rad);
+                let r = sigmas.pseudorange_sigma_m(obs, el).powi(2);
+                sat.r_pseudorange_m2 = r;
+                candidates.push(Candidate {
+                    sat_index: index,
+                    is_rate: false,
+                    row: geo.pseudorange_row(&pred.los_ecef),
+                    y: pred.pseudorange_m - obs.pseudorange_m,
+                    r,
+                });
+                if let (true, Some(rate)) =
+                    (config.gnss.use_pseudorange_rate, obs.pseudorange_rate_mps)
+                {
+                    let r = sigmas.pseudorange_rate_sigma_mps(obs, el).powi(2);
+                    sat.r_rate_m2_s2 = r;
+                    candidates.push(Candidate {
+                        sat_index: index,
+                        is_rate: true,
+                        row: geo.pseudorange_rate_row(&pred.los_ecef),
+                        y: pred.pseudorange_rate_mps - rate,
+                        r,
+                    });
+                }
+            }
+        }
+        report.satellites.push(sat);
+    }
+    report.clock_jump_m = absorb_clock_jump(state, &mut candidates, config.gnss.max_clock_jump_m);
+    gate(&mut candidates, &state.p, config.gnss.innovation_gate_sigma, &mut report);
+    if candidates.is_empty() {
+        return Ok(report);
+    }
+    let m = candidates.len();
+    let mut h = DMatrix::zeros(m, crate::ins::error_state::N);
+    let mut y = DVector::zeros(m);
+    let mut r = DMatrix::zeros(m, m);
+    for (i, c) in candidates.iter().enumerate() {
+        h.row_mut(i).copy_from(&c.row);
+        y[i] = c.y;
+        r[(i, i)] = c.r;
+    }
+    let result = ekf::update(&state.p, &h, &y, &r, config.filter.joseph_form)?;
+    for (i, c) in candidates.iter().enumerate() {
+        let sat = &mut report.satellites[c.sat_index];
+        let normalized = -c.y / result.s[(i, i)].sqrt();
+        if c.is_rate {
+            sat.used_rate = true;
+            sat.innovation_rate_mps = -c.y;
+            sat.normalized_innovation_rate = normalized;
+        } else {
+            sat.used_pseudorange = true;
+            sat.innovation_pseudorange_m = -c.y;
+            sat.normalized_innovation_pseudorange = normalized;
+        }
+    }
+    state.p = result.p;
+    state.apply_correction(&result.dx);
+    report.measurements_used = m;
+    report.nis = result.nis;
+    Ok(report)
+}
+
+/// Checks one observation against the masks and predicts it.
+fn screen(
+    obs: &crate::gnss::SatObservation,
+    rx_pos: &Vector3<f64>,
+    rx_vel: &Vector3<f64>,
+    state: &FilterState,
+    epoch: &GnssEpoch,
+    config: &Config,
+) -> Result<SatPrediction, SatRejection> {
+    if !config.gnss.constellations.contains(&obs.sat.constellation) {
+        return Err(SatRejection::ConstellationDisabled);
+    }
+    if !obs.pseudorange_m.is_finite() {
+        return Err(SatRejection::NotANumber);
+    }
+    if config.gnss.cn0_mask_dbhz > 0.0 {
+        match obs.cn0_dbhz {
+            Some(cn0) if cn0 >= config.gnss.cn0_mask_dbhz => {}
+            _ => return Err(SatRejection::Cn0Mask),
+        }
+    }
+    let pred = geometry::predict(
+        obs,
+        rx_pos,
+        rx_vel,
+        state.clock_bias_m,
+        state.clock_drift_mps,
+        epoch.klobuchar.as_ref(),
+        epoch.gps_time_of_week_s,
+    )
+    .map_err(|_| SatRejection::NoSatelliteState)?;
+    if pred.elevation_rad < config.gnss.elevation_mask_rad {
+        return Err(SatRejection::ElevationMask);
+    }
+    Ok(pred)
+}
+
+fn median(values: &mut [f64]) -> Option<f64> {
+    if values.is_empty() {
+        return None;
+    }
+    values.sort_by(f64::total_cmp);
+    let n = values.len();
+    Some(if n % 2 == 1 {
+        values[n / 2]
+    } else {
+        0.5 * (values[n / 2 - 1] + values[n / 2])
+    })
+}
+
+/// Receivers that do not steer their clock jump it by whole milliseconds (about 300 km of
+/// range), common to every pseudo-range. When the median pseudo-range innovation exceeds
+/// `threshold_m`, it is absorbed into the clock state instead of rejecting every
+/// satellite. Returns the jump (m), 0 if none.
+fn absorb_clock_jump(
+    state: &mut FilterState,
+    candidates: &mut [Candidate],
+    threshold_m: f64,
+) -> f64 {
+    let mut ys: Vec<f64> = candidates.iter().filter(|c| !c.is_rate).map(|c| c.y).collect();
+    match median(&mut ys) {
+        Some(common) if common.abs() > threshold_m => {
+            // y = predicted − measured: a jump +J of the receiver clock gives y = −J.
+            state.clock_bias_m -= common;
+            for c in candidates.iter_mut().filter(|c| !c.is_rate) {
+                c.y -= common;
+            }
+            -common
+        }
+        _ => 0.0,
+    }
+}
+
+/// Innovation gate on each scalar measurement.
+///
+/// Choice: with three or more measurements of a kind, the gate tests each innovation's
+/// distance from the median innovation of its kind, scaled by its own √S. A receiver clock
+/// offset or drift error shifts all innovations of a kind together; that is for the update
+/// to estimate, not a reason to reject every satellite. With fewer, the plain |y|/√S test.
+fn gate(
+    candidates: &mut Vec<Candidate>,
+    p: &crate::ins::error_state::StateMatrix,
+    gate_sigma: f64,
+    report: &mut EpochReport,
+) {
+    if gate_sigma <= 0.0 {
+        return;
+    }
+    let common = |is_rate: bool, cands: &[Candidate]| {
+        let mut ys: Vec<f64> = cands.iter().filter(|c| c.is_rate == is_rate).map(|c| c.y).collect();
+        if ys.len() >= 3 {
+            median(&mut ys).unwrap_or(0.0)
+        } else {
+            0.0
+        }
+    };
+    let common_range = common(false, candidates);
+    let common_rate = common(true, candidates);
+    candidates.retain(|c| {
+        let s = (c.row * p * c.row.transpose())[(0, 0)] + c.r;
+        let offset = if c.is_rate { common_rate } else { common_range };
+        let keep = (c.y - offset).abs() <= gate_sigma * s.sqrt();
+        if !keep {
+            let sat = &mut report.satellites[c.sat_index];
+            if sat.rejection.is_none() {
+                sat.rejection = Some(SatRejection::InnovationGate);
+            }
+            if c.is_rate {
+                sat.innovation_rate_mps = -c.y;
+                sat.normalized_innovation_rate = -c.y / s.sqrt();
+            } else {
+                sat.innovation_pseudorange_m = -c.y;
+                sat.normalized_innovation_pseudorange = -c.y / s.sqrt();
+            }
+        }
+        keep
+    });
+}
