@@ -1,0 +1,411 @@
+//! The configuration exactly as written in the parameter file: human units in the key names,
+//! every key optional (a missing key takes its documented default), unknown keys refused.
+//!
+//! The defaults here are THE documented defaults: `params/ekf.yaml` is tested to equal them.
+
+use serde::Deserialize;
+use serde_yaml::{Mapping, Value};
+
+use super::{Coupling, FilterVariant};
+use crate::gnss::Constellation;
+
+/// The whole parameter file below `ros__parameters:`, in human units.
+#[derive(Debug, Clone, PartialEq, Default, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RawConfig {
+    pub filter: RawFilter,
+    pub imu: RawImu,
+    pub mounting: RawMounting,
+    pub clock: RawClock,
+    pub gnss: RawGnss,
+    pub loose: RawLoose,
+    pub init: RawInit,
+    pub engine: RawEngine,
+    pub output: RawOutput,
+}
+
+/// `filter.*`: which filter runs.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RawFilter {
+    pub variant: FilterVariant,
+    pub coupling: Coupling,
+    pub joseph_form: bool,
+}
+
+impl Default for RawFilter {
+    fn default() -> Self {
+        Self {
+            variant: FilterVariant::Ekf,
+            coupling: Coupling::Tight,
+            joseph_form: true,
+        }
+    }
+}
+
+/// `imu.*`: inertial sensor noise, in data-sheet units.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RawImu {
+    pub gyro_arw_deg_per_sqrt_h: f64,
+    pub gyro_bias_deg_per_h: f64,
+    pub gyro_markov_sigma_deg_per_h: f64,
+    pub gyro_markov_correlation_time_s: f64,
+    pub accel_vrw_ug_per_sqrt_hz: f64,
+    pub accel_bias_ug: f64,
+    pub accel_bias_correlation_time_s: f64,
+}
+
+impl Default for RawImu {
+    fn default() -> Self {
+        Self {
+            gyro_arw_deg_per_sqrt_h: 0.012,
+            gyro_bias_deg_per_h: 0.5,
+            gyro_markov_sigma_deg_per_h: 0.5,
+            gyro_markov_correlation_time_s: 3600.0,
+            accel_vrw_ug_per_sqrt_hz: 100.0,
+            accel_bias_ug: 1250.0,
+            accel_bias_correlation_time_s: 3600.0,
+        }
+    }
+}
+
+/// `mounting.*`: IMU orientation and antenna lever arm.
+#[derive(Debug, Clone, PartialEq, Default, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RawMounting {
+    pub imu_rotation_rpy_deg: [f64; 3],
+    pub antenna_lever_arm_m: [f64; 3],
+}
+
+/// `clock.*`: receiver clock model (bias and drift in metres).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RawClock {
+    pub bias_noise_m_per_sqrt_s: f64,
+    pub drift_noise_mps_per_sqrt_s: f64,
+    pub drift_correlation_time_s: f64,
+}
+
+impl Default for RawClock {
+    fn default() -> Self {
+        Self {
+            bias_noise_m_per_sqrt_s: 0.5,
+            drift_noise_mps_per_sqrt_s: 0.1,
+            drift_correlation_time_s: 1800.0,
+        }
+    }
+}
+
+/// `gnss.*`: raw measurement selection and weighting (tight coupling).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RawGnss {
+    pub elevation_mask_deg: f64,
+    pub cn0_mask_dbhz: f64,
+    pub pseudorange_sigma_m: f64,
+    pub pseudorange_rate_sigma_mps: f64,
+    pub elevation_weighting: bool,
+    pub use_receiver_sigmas: bool,
+    pub use_pseudorange_rate: bool,
+    pub innovation_gate_sigma: f64,
+    pub constellations: Vec<ConstellationName>,
+    pub clock_jump_threshold_m: f64,
+}
+
+impl Default for RawGnss {
+    fn default() -> Self {
+        Self {
+            elevation_mask_deg: 10.0,
+            cn0_mask_dbhz: 0.0,
+            pseudorange_sigma_m: 3.0,
+            pseudorange_rate_sigma_mps: 0.1,
+            elevation_weighting: true,
+            use_receiver_sigmas: false,
+            use_pseudorange_rate: true,
+            innovation_gate_sigma: 5.0,
+            constellations: vec![
+                ConstellationName::Gps,
+                ConstellationName::Galileo,
+                ConstellationName::Beidou,
+            ],
+            clock_jump_threshold_m: 100_000.0,
+        }
+    }
+}
+
+/// `loose.*`: receiver fix weighting (loose coupling).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RawLoose {
+    pub use_fix_covariance: bool,
+    pub fix_sigma_horizontal_m: f64,
+    pub fix_sigma_vertical_m: f64,
+    pub velocity_sigma_mps: f64,
+}
+
+impl Default for RawLoose {
+    fn default() -> Self {
+        Self {
+            use_fix_covariance: true,
+            fix_sigma_horizontal_m: 1.5,
+            fix_sigma_vertical_m: 3.0,
+            velocity_sigma_mps: 0.1,
+        }
+    }
+}
+
+/// `init.*`: start-up (alignment) and the initial 1σ of every state block.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RawInit {
+    pub heading_deg: Option<f64>,
+    pub heading_min_speed_mps: f64,
+    pub leveling_duration_s: f64,
+    pub min_satellites: usize,
+    pub attitude_sigma_deg: f64,
+    pub heading_sigma_deg: f64,
+    pub velocity_sigma_mps: f64,
+    pub position_sigma_m: f64,
+    pub clock_bias_sigma_m: f64,
+    pub clock_drift_sigma_mps: f64,
+}
+
+impl Default for RawInit {
+    fn default() -> Self {
+        Self {
+            heading_deg: None,
+            heading_min_speed_mps: 1.0,
+            leveling_duration_s: 1.0,
+            min_satellites: 5,
+            attitude_sigma_deg: 1.0,
+            heading_sigma_deg: 5.0,
+            velocity_sigma_mps: 0.5,
+            position_sigma_m: 5.0,
+            clock_bias_sigma_m: 30.0,
+            clock_drift_sigma_mps: 5.0,
+        }
+    }
+}
+
+/// `engine.*`: buffering of the sensor streams.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RawEngine {
+    pub imu_buffer_s: f64,
+    pub max_imu_gap_s: f64,
+}
+
+impl Default for RawEngine {
+    fn default() -> Self {
+        Self {
+            imu_buffer_s: 2.0,
+            max_imu_gap_s: 1.0,
+        }
+    }
+}
+
+/// `output.*`: what is published and where the local frame sits.
+#[derive(Debug, Clone, PartialEq, Default, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RawOutput {
+    pub datum_llh_deg_m: Option<[f64; 3]>,
+    pub rate_hz: f64,
+}
+
+/// Constellation names as written in the parameter file (a local mapping, so the GNSS
+/// observation type stays free of serde).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ConstellationName {
+    Gps,
+    Glonass,
+    Galileo,
+    Beidou,
+    Qzss,
+    Sbas,
+}
+
+impl ConstellationName {
+    /// The name as written in the file.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Gps => "gps",
+            Self::Glonass => "glonass",
+            Self::Galileo => "galileo",
+            Self::Beidou => "beidou",
+            Self::Qzss => "qzss",
+            Self::Sbas => "sbas",
+        }
+    }
+}
+
+impl From<ConstellationName> for Constellation {
+    fn from(name: ConstellationName) -> Self {
+        match name {
+            ConstellationName::Gps => Self::Gps,
+            ConstellationName::Glonass => Self::Glonass,
+            ConstellationName::Galileo => Self::Galileo,
+            ConstellationName::Beidou => Self::Beidou,
+            ConstellationName::Qzss => Self::Qzss,
+            ConstellationName::Sbas => Self::Sbas,
+        }
+    }
+}
+
+impl From<Constellation> for ConstellationName {
+    fn from(constellation: Constellation) -> Self {
+        match constellation {
+            Constellation::Gps => Self::Gps,
+            Constellation::Glonass => Self::Glonass,
+            Constellation::Galileo => Self::Galileo,
+            Constellation::Beidou => Self::Beidou,
+            Constellation::Qzss => Self::Qzss,
+            Constellation::Sbas => Self::Sbas,
+        }
+    }
+}
+
+impl RawConfig {
+    /// The parameters as a YAML tree, section -> key -> value, in file order. This is the
+    /// inverse of deserialisation (tested), written out so that it cannot fail.
+    pub fn to_tree(&self) -> Mapping {
+        let f = &self.filter;
+        let i = &self.imu;
+        let m = &self.mounting;
+        let c = &self.clock;
+        let g = &self.gnss;
+        let l = &self.loose;
+        let n = &self.init;
+        let e = &self.engine;
+        let o = &self.output;
+        let constellations = g.constellations.iter().map(|c| text(c.as_str())).collect();
+        let sections = [
+            (
+                "filter",
+                vec![
+                    ("variant", text(f.variant.as_str())),
+                    ("coupling", text(f.coupling.as_str())),
+                    ("joseph_form", Value::Bool(f.joseph_form)),
+                ],
+            ),
+            (
+                "imu",
+                vec![
+                    ("gyro_arw_deg_per_sqrt_h", num(i.gyro_arw_deg_per_sqrt_h)),
+                    ("gyro_bias_deg_per_h", num(i.gyro_bias_deg_per_h)),
+                    (
+                        "gyro_markov_sigma_deg_per_h",
+                        num(i.gyro_markov_sigma_deg_per_h),
+                    ),
+                    (
+                        "gyro_markov_correlation_time_s",
+                        num(i.gyro_markov_correlation_time_s),
+                    ),
+                    ("accel_vrw_ug_per_sqrt_hz", num(i.accel_vrw_ug_per_sqrt_hz)),
+                    ("accel_bias_ug", num(i.accel_bias_ug)),
+                    (
+                        "accel_bias_correlation_time_s",
+                        num(i.accel_bias_correlation_time_s),
+                    ),
+                ],
+            ),
+            (
+                "mounting",
+                vec![
+                    ("imu_rotation_rpy_deg", triple(&m.imu_rotation_rpy_deg)),
+                    ("antenna_lever_arm_m", triple(&m.antenna_lever_arm_m)),
+                ],
+            ),
+            (
+                "clock",
+                vec![
+                    ("bias_noise_m_per_sqrt_s", num(c.bias_noise_m_per_sqrt_s)),
+                    (
+                        "drift_noise_mps_per_sqrt_s",
+                        num(c.drift_noise_mps_per_sqrt_s),
+                    ),
+                    ("drift_correlation_time_s", num(c.drift_correlation_time_s)),
+                ],
+            ),
+            (
+                "gnss",
+                vec![
+                    ("elevation_mask_deg", num(g.elevation_mask_deg)),
+                    ("cn0_mask_dbhz", num(g.cn0_mask_dbhz)),
+                    ("pseudorange_sigma_m", num(g.pseudorange_sigma_m)),
+                    (
+                        "pseudorange_rate_sigma_mps",
+                        num(g.pseudorange_rate_sigma_mps),
+                    ),
+                    ("elevation_weighting", Value::Bool(g.elevation_weighting)),
+                    ("use_receiver_sigmas", Value::Bool(g.use_receiver_sigmas)),
+                    ("use_pseudorange_rate", Value::Bool(g.use_pseudorange_rate)),
+                    ("innovation_gate_sigma", num(g.innovation_gate_sigma)),
+                    ("constellations", Value::Sequence(constellations)),
+                    ("clock_jump_threshold_m", num(g.clock_jump_threshold_m)),
+                ],
+            ),
+            (
+                "loose",
+                vec![
+                    ("use_fix_covariance", Value::Bool(l.use_fix_covariance)),
+                    ("fix_sigma_horizontal_m", num(l.fix_sigma_horizontal_m)),
+                    ("fix_sigma_vertical_m", num(l.fix_sigma_vertical_m)),
+                    ("velocity_sigma_mps", num(l.velocity_sigma_mps)),
+                ],
+            ),
+            (
+                "init",
+                vec![
+                    ("heading_deg", n.heading_deg.map_or(Value::Null, num)),
+                    ("heading_min_speed_mps", num(n.heading_min_speed_mps)),
+                    ("leveling_duration_s", num(n.leveling_duration_s)),
+                    ("min_satellites", Value::from(n.min_satellites)),
+                    ("attitude_sigma_deg", num(n.attitude_sigma_deg)),
+                    ("heading_sigma_deg", num(n.heading_sigma_deg)),
+                    ("velocity_sigma_mps", num(n.velocity_sigma_mps)),
+                    ("position_sigma_m", num(n.position_sigma_m)),
+                    ("clock_bias_sigma_m", num(n.clock_bias_sigma_m)),
+                    ("clock_drift_sigma_mps", num(n.clock_drift_sigma_mps)),
+                ],
+            ),
+            (
+                "engine",
+                vec![
+                    ("imu_buffer_s", num(e.imu_buffer_s)),
+                    ("max_imu_gap_s", num(e.max_imu_gap_s)),
+                ],
+            ),
+            (
+                "output",
+                vec![
+                    (
+                        "datum_llh_deg_m",
+                        o.datum_llh_deg_m.as_ref().map_or(Value::Null, triple),
+                    ),
+                    ("rate_hz", num(o.rate_hz)),
+                ],
+            ),
+        ];
+        sections
+            .into_iter()
+            .map(|(section, keys)| {
+                let keys = keys.into_iter().map(|(k, v)| (text(k), v)).collect();
+                (text(section), Value::Mapping(keys))
+            })
+            .collect()
+    }
+}
+
+fn num(x: f64) -> Value {
+    Value::from(x)
+}
+
+fn text(s: &str) -> Value {
+    Value::String(s.to_owned())
+}
+
+fn triple(v: &[f64; 3]) -> Value {
+    Value::Sequence(v.iter().copied().map(num).collect())
+}
