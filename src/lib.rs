@@ -18,6 +18,7 @@
 
 pub mod config;
 pub mod earth;
+pub mod engine;
 pub mod filter;
 pub mod gnss;
 pub mod ins;

@@ -1,9 +1,8 @@
 //! Start-up with no hand-entered state.
 //!
 //! 1. Levelling: roll and pitch from the mean specific force over
-//!    `init.leveling_duration_s` at rest (and, when `init.gyro_bias_at_rest` is set, the
-//!    gyro bias from the mean angular rate less the earth rate, resolved once the position
-//!    and heading are known).
+//!    `init.leveling_duration_s` at rest, and the gyro bias from the mean angular rate
+//!    less the earth rate (resolved once the position and heading are known).
 //! 2. Until the filter starts, the attitude is carried forward by the gyros alone.
 //! 3. Position, velocity and clock come from an iterated least-squares single-point
 //!    solution (tightly coupled) or the receiver's fix (loosely coupled).
@@ -78,7 +77,11 @@ pub struct Initializer {
 impl Initializer {
     /// Keeps what was learned about the attitude (after a reset the filter restarts from
     /// it instead of levelling again, which would need the vehicle at rest).
-    pub fn with_attitude(q_nb: UnitQuaternion<f64>, gyro_bias_rad_s: Vector3<f64>, t_s: f64) -> Self {
+    pub fn with_attitude(
+        q_nb: UnitQuaternion<f64>,
+        gyro_bias_rad_s: Vector3<f64>,
+        t_s: f64,
+    ) -> Self {
         Self {
             attitude: Some(Attitude {
                 q_nb,
@@ -128,16 +131,11 @@ impl Initializer {
             let pitch = (-f[0]).atan2(f[1].hypot(f[2]));
             let yaw = config.init.heading_rad.unwrap_or(0.0);
             let q_nb = UnitQuaternion::from_euler_angles(roll, pitch, yaw);
-            let (gyro_bias_rad_s, at_rest) = if config.init.gyro_bias_at_rest {
-                (w, Some((q_nb, w)))
-            } else {
-                (Vector3::zeros(), None)
-            };
             self.attitude = Some(Attitude {
                 q_nb,
-                gyro_bias_rad_s,
+                gyro_bias_rad_s: w,
                 last_t_s: s.t_s,
-                at_rest,
+                at_rest: Some((q_nb, w)),
             });
         }
     }
@@ -198,7 +196,9 @@ impl Initializer {
         let q_nb = replace_yaw(&attitude.q_nb, yaw);
         let position_var = fix
             .position_covariance_enu_m2
-            .map_or(config.loose.fix_sigma_horizontal_m.powi(2), |c| c.trace() / 3.0);
+            .map_or(config.loose.fix_sigma_horizontal_m.powi(2), |c| {
+                c.trace() / 3.0
+            });
         let mut init = self.initial_state(
             fix.t_s,
             &fix.position,
@@ -234,7 +234,8 @@ impl Initializer {
     ) -> InitialState {
         // The solution is the antenna's: move it to the IMU by the lever arm.
         let lever_n = q_nb * config.mounting.lever_arm_b_m;
-        let imu_ecef = earth::llh_to_ecef(antenna) - earth::rot_ecef_to_enu(antenna).transpose() * lever_n;
+        let imu_ecef =
+            earth::llh_to_ecef(antenna) - earth::rot_ecef_to_enu(antenna).transpose() * lever_n;
         let p = earth::ecef_to_llh(&imu_ecef).unwrap_or(*antenna);
         let nav = NavState {
             t_s,
@@ -255,7 +256,11 @@ impl Initializer {
         set3(&mut cov, DV, [vel, vel, vel]);
         let pos = i.position_sigma_m.powi(2).max(position_var_m2);
         let (north, east) = earth::metres_per_radian(&p);
-        set3(&mut cov, DP, [pos / (north * north), pos / (east * east), pos]);
+        set3(
+            &mut cov,
+            DP,
+            [pos / (north * north), pos / (east * east), pos],
+        );
         let gb = config.imu.gyro_bias_sigma_rad_s.powi(2);
         set3(&mut cov, GYRO_BIAS, [gb, gb, gb]);
         let gm = config.imu.gyro_markov_sigma_rad_s.powi(2);
@@ -266,11 +271,14 @@ impl Initializer {
         cov[(CLOCK_DRIFT, CLOCK_DRIFT)] = i.clock_drift_sigma_mps.powi(2);
         // The bias at rest is the mean rate less the earth rate seen in the body frame,
         // which needs the heading: the levelled attitude turned by the yaw found since.
-        let gyro_bias_rad_s = attitude.at_rest.map_or(attitude.gyro_bias_rad_s, |(q_level, w_rest)| {
-            let yaw_offset = q_nb.euler_angles().2 - attitude.q_nb.euler_angles().2;
-            let q_rest = UnitQuaternion::from_euler_angles(0.0, 0.0, yaw_offset) * q_level;
-            w_rest - q_rest.inverse() * earth::earth_rate_enu_rad_s(p.lat_rad)
-        });
+        let gyro_bias_rad_s =
+            attitude
+                .at_rest
+                .map_or(attitude.gyro_bias_rad_s, |(q_level, w_rest)| {
+                    let yaw_offset = q_nb.euler_angles().2 - attitude.q_nb.euler_angles().2;
+                    let q_rest = UnitQuaternion::from_euler_angles(0.0, 0.0, yaw_offset) * q_level;
+                    w_rest - q_rest.inverse() * earth::earth_rate_enu_rad_s(p.lat_rad)
+                });
         InitialState {
             nav,
             gyro_bias_rad_s,

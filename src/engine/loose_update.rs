@@ -34,7 +34,9 @@ impl GnssFix {
         self.t_s.is_finite()
             && self.position.is_finite()
             && finite3(&self.position_covariance_enu_m2)
-            && self.velocity_enu_mps.is_none_or(|v| v.iter().all(|x| x.is_finite()))
+            && self
+                .velocity_enu_mps
+                .is_none_or(|v| v.iter().all(|x| x.is_finite()))
             && finite3(&self.velocity_covariance_enu_m2_s2)
     }
 }
@@ -76,8 +78,8 @@ pub fn update(
     let geo = AntennaGeometry::new(&state.nav, &config.mounting.lever_arm_b_m, w_ib_b_rad_s);
     // Position innovation in the ENU frame at the nominal point (predicted − measured).
     let predicted_ecef = geo.antenna_ecef_m(&state.nav.p);
-    let y_pos = earth::rot_ecef_to_enu(&state.nav.p)
-        * (predicted_ecef - earth::llh_to_ecef(&fix.position));
+    let y_pos =
+        earth::rot_ecef_to_enu(&state.nav.p) * (predicted_ecef - earth::llh_to_ecef(&fix.position));
     let with_velocity = fix.velocity_enu_mps.is_some();
     let m = if with_velocity { 6 } else { 3 };
     let mut h = DMatrix::zeros(m, N);
@@ -87,14 +89,16 @@ pub fn update(
         h.row_mut(i).copy_from(row);
         y[i] = y_pos[i];
     }
-    r.view_mut((0, 0), (3, 3)).copy_from(&position_covariance(fix, config));
+    r.view_mut((0, 0), (3, 3))
+        .copy_from(&position_covariance(fix, config));
     if let Some(v) = fix.velocity_enu_mps {
         let y_vel = state.nav.v_n + geo.lever_velocity_enu_mps() - v;
         for (i, row) in geo.velocity_rows().iter().enumerate() {
             h.row_mut(3 + i).copy_from(row);
             y[3 + i] = y_vel[i];
         }
-        r.view_mut((3, 3), (3, 3)).copy_from(&velocity_covariance(fix, config));
+        r.view_mut((3, 3), (3, 3))
+            .copy_from(&velocity_covariance(fix, config));
     }
     let result = ekf::update(&state.p, &h, &y, &r, config.filter.joseph_form)?;
     state.p = result.p;

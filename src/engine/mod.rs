@@ -71,7 +71,7 @@ struct Snapshot {
 
 #[derive(Debug, Clone)]
 enum Phase {
-    Initializing(Initializer),
+    Initializing(Box<Initializer>),
     Running(Box<FilterState>),
 }
 
@@ -88,7 +88,7 @@ pub struct Engine {
     pending: Vec<Pending>,
     last_output_t_s: f64,
     counters: RejectionCounters,
-    /// Reports are suppressed while re-integrating after a roll-back.
+    /// Solutions are not emitted while re-integrating after a roll-back.
     replaying: bool,
 }
 
@@ -98,7 +98,7 @@ impl Engine {
         Self {
             config,
             noise,
-            phase: Phase::Initializing(Initializer::default()),
+            phase: Phase::Initializing(Box::default()),
             imu: VecDeque::new(),
             history: VecDeque::new(),
             pending: Vec::new(),
@@ -140,19 +140,19 @@ impl Engine {
 
     /// The configured filter variant's name.
     pub fn variant_name(&self) -> &'static str {
-        self.config.filter.variant.name()
+        self.config.filter.variant.as_str()
     }
 
     /// Forgets everything (as after a time jump backwards) and starts again; the attitude
     /// learned so far is kept when the filter was running.
     pub fn reset(&mut self, t_s: f64, reason: ResetReason) -> Output {
         let init = match &self.phase {
-            Phase::Running(s) => Initializer::with_attitude(
+            Phase::Running(s) => Box::new(Initializer::with_attitude(
                 s.nav.q_nb,
                 s.gyro_bias_rad_s + s.gyro_markov_rad_s,
                 s.last_imu.t_s,
-            ),
-            Phase::Initializing(_) => Initializer::default(),
+            )),
+            Phase::Initializing(_) => Box::default(),
         };
         self.phase = Phase::Initializing(init);
         self.imu.clear();
@@ -170,16 +170,22 @@ impl Engine {
             f_ib_b_m_s2: self.config.mounting.imu_to_body * sample.f_ib_b_m_s2,
         };
         if !body.is_finite() {
-            return Err(self.counters.reject(RejectionReason::ImuNotFinite, sample.t_s));
+            return Err(self
+                .counters
+                .reject(RejectionReason::ImuNotFinite, sample.t_s));
         }
         let mut out = Vec::new();
         if let Some(last) = self.imu.back() {
             let dt = body.t_s - last.t_s;
             if dt == 0.0 {
-                return Err(self.counters.reject(RejectionReason::ImuDuplicate, body.t_s));
+                return Err(self
+                    .counters
+                    .reject(RejectionReason::ImuDuplicate, body.t_s));
             }
             if dt < 0.0 {
-                return Err(self.counters.reject(RejectionReason::ImuOutOfOrder, body.t_s));
+                return Err(self
+                    .counters
+                    .reject(RejectionReason::ImuOutOfOrder, body.t_s));
             }
             if dt > self.config.engine.max_imu_gap_s {
                 self.counters.reject(RejectionReason::ImuGap, body.t_s);
@@ -191,7 +197,11 @@ impl Engine {
         while self.imu.front().is_some_and(|s| s.t_s < horizon) && self.imu.len() > 2 {
             self.imu.pop_front();
         }
-        while self.history.front().is_some_and(|s| s.state.last_imu.t_s < horizon) {
+        while self
+            .history
+            .front()
+            .is_some_and(|s| s.state.last_imu.t_s < horizon)
+        {
             self.history.pop_front();
         }
         self.advance(&body, &mut out);
@@ -201,13 +211,19 @@ impl Engine {
     /// Feeds one GNSS epoch (tightly coupled).
     pub fn push_gnss(&mut self, epoch: GnssEpoch) -> Result<Vec<Output>, InputRejected> {
         if !epoch.t_s.is_finite() || !epoch.gps_time_of_week_s.is_finite() {
-            return Err(self.counters.reject(RejectionReason::GnssNotFinite, epoch.t_s));
+            return Err(self
+                .counters
+                .reject(RejectionReason::GnssNotFinite, epoch.t_s));
         }
         if epoch.satellites.is_empty() {
-            return Err(self.counters.reject(RejectionReason::GnssNoSatellites, epoch.t_s));
+            return Err(self
+                .counters
+                .reject(RejectionReason::GnssNoSatellites, epoch.t_s));
         }
         if self.config.filter.coupling != Coupling::Tight {
-            return Err(self.counters.reject(RejectionReason::WrongCoupling, epoch.t_s));
+            return Err(self
+                .counters
+                .reject(RejectionReason::WrongCoupling, epoch.t_s));
         }
         self.push_measurement(Measurement::Gnss(epoch))
     }
@@ -218,7 +234,9 @@ impl Engine {
             return Err(self.counters.reject(RejectionReason::FixNotFinite, fix.t_s));
         }
         if self.config.filter.coupling != Coupling::Loose {
-            return Err(self.counters.reject(RejectionReason::WrongCoupling, fix.t_s));
+            return Err(self
+                .counters
+                .reject(RejectionReason::WrongCoupling, fix.t_s));
         }
         self.push_measurement(Measurement::Fix(fix))
     }
@@ -231,9 +249,14 @@ impl Engine {
             return Ok(Vec::new());
         };
         if self.pending.iter().any(|p| p.measurement.t_s() == t)
-            || self.history.iter().any(|s| s.applied.iter().any(|a| a.t_s() == t))
+            || self
+                .history
+                .iter()
+                .any(|s| s.applied.iter().any(|a| a.t_s() == t))
         {
-            return Err(self.counters.reject(RejectionReason::MeasurementDuplicate, t));
+            return Err(self
+                .counters
+                .reject(RejectionReason::MeasurementDuplicate, t));
         }
         if t > last_t {
             self.enqueue(m, false);
@@ -277,7 +300,13 @@ impl Engine {
     fn enqueue(&mut self, measurement: Measurement, reported: bool) {
         let t = measurement.t_s();
         let at = self.pending.partition_point(|p| p.measurement.t_s() <= t);
-        self.pending.insert(at, Pending { measurement, reported });
+        self.pending.insert(
+            at,
+            Pending {
+                measurement,
+                reported,
+            },
+        );
     }
 
     /// Re-integrates the buffered IMU samples after `start` (or all of them when the
@@ -287,13 +316,14 @@ impl Engine {
         if let Some(state) = start {
             self.phase = Phase::Running(Box::new(state));
         }
-        let samples: Vec<ImuSample> = self.imu.iter().filter(|s| s.t_s > from_t).copied().collect();
-        let last_t = samples.last().map(|s| s.t_s);
+        let samples: Vec<ImuSample> = self
+            .imu
+            .iter()
+            .filter(|s| s.t_s > from_t)
+            .copied()
+            .collect();
         self.replaying = true;
         for s in &samples {
-            if Some(s.t_s) == last_t {
-                self.replaying = false;
-            }
             self.advance(s, out);
         }
         self.replaying = false;
@@ -302,7 +332,11 @@ impl Engine {
     /// Processes everything up to the body-frame sample `s` (already buffered).
     fn advance(&mut self, s: &ImuSample, out: &mut Vec<Output>) {
         let mut applied = Vec::new();
-        while self.pending.first().is_some_and(|p| p.measurement.t_s() <= s.t_s) {
+        while self
+            .pending
+            .first()
+            .is_some_and(|p| p.measurement.t_s() <= s.t_s)
+        {
             let p = self.pending.remove(0);
             self.apply_measurement(&p, s, out);
             applied.push(p.measurement);
@@ -330,7 +364,7 @@ impl Engine {
     /// then applies it.
     fn apply_measurement(&mut self, p: &Pending, next: &ImuSample, out: &mut Vec<Output>) {
         let t = p.measurement.t_s();
-        let report = !self.replaying && !p.reported;
+        let report = !p.reported;
         match &mut self.phase {
             Phase::Initializing(init) => {
                 let started = match &p.measurement {
@@ -338,7 +372,13 @@ impl Engine {
                     Measurement::Fix(f) => init.try_fix(f, &self.config),
                 };
                 if let Some(initial) = started {
-                    let before = self.imu.iter().rev().find(|s| s.t_s <= t).copied().unwrap_or(*next);
+                    let before = self
+                        .imu
+                        .iter()
+                        .rev()
+                        .find(|s| s.t_s <= t)
+                        .copied()
+                        .unwrap_or(*next);
                     let last_imu = interpolate(&before, next, t);
                     let state = FilterState {
                         nav: initial.nav,
@@ -370,11 +410,15 @@ impl Engine {
                     }
                 }
                 let w = state.compensate(&state.last_imu).w_ib_b_rad_s;
-                let variant = self.config.filter.variant.name();
+                let variant = self.config.filter.variant.as_str();
                 let before = state.as_ref().clone();
                 let result = match &p.measurement {
-                    Measurement::Gnss(e) => tight_update::update(state, e, &w, &self.config, variant),
-                    Measurement::Fix(f) => loose_update::update(state, f, &w, &self.config, variant),
+                    Measurement::Gnss(e) => {
+                        tight_update::update(state, e, &w, &self.config, variant)
+                    }
+                    Measurement::Fix(f) => {
+                        loose_update::update(state, f, &w, &self.config, variant)
+                    }
                 };
                 match result {
                     Ok(epoch) if state.is_finite() => {

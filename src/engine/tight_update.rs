@@ -100,7 +100,12 @@ pub fn update(
         report.satellites.push(sat);
     }
     report.clock_jump_m = absorb_clock_jump(state, &mut candidates, config.gnss.max_clock_jump_m);
-    gate(&mut candidates, &state.p, config.gnss.innovation_gate_sigma, &mut report);
+    gate(
+        &mut candidates,
+        &state.p,
+        config.gnss.innovation_gate_sigma,
+        &mut report,
+    );
     if candidates.is_empty() {
         return Ok(report);
     }
@@ -193,7 +198,11 @@ fn absorb_clock_jump(
     candidates: &mut [Candidate],
     threshold_m: f64,
 ) -> f64 {
-    let mut ys: Vec<f64> = candidates.iter().filter(|c| !c.is_rate).map(|c| c.y).collect();
+    let mut ys: Vec<f64> = candidates
+        .iter()
+        .filter(|c| !c.is_rate)
+        .map(|c| c.y)
+        .collect();
     match median(&mut ys) {
         Some(common) if common.abs() > threshold_m => {
             // y = predicted − measured: a jump +J of the receiver clock gives y = −J.
@@ -223,7 +232,11 @@ fn gate(
         return;
     }
     let common = |is_rate: bool, cands: &[Candidate]| {
-        let mut ys: Vec<f64> = cands.iter().filter(|c| c.is_rate == is_rate).map(|c| c.y).collect();
+        let mut ys: Vec<f64> = cands
+            .iter()
+            .filter(|c| c.is_rate == is_rate)
+            .map(|c| c.y)
+            .collect();
         if ys.len() >= 3 {
             median(&mut ys).unwrap_or(0.0)
         } else {

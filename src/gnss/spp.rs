@@ -657,13 +657,13 @@ fn validate(config: &SppConfig) -> Result<(), SppError> {
         (
             config
                 .outlier_threshold
-                .map_or(true, |t| t.is_finite() && t > 0.0),
+                .is_none_or(|t| t.is_finite() && t > 0.0),
             "outlier threshold must be positive",
         ),
         (
             config
                 .initial_position_ecef_m
-                .map_or(true, |p| p.iter().all(|v| v.is_finite())),
+                .is_none_or(|p| p.iter().all(|v| v.is_finite())),
             "initial position must be finite",
         ),
     ];
