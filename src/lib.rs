@@ -22,4 +22,5 @@ pub mod engine;
 pub mod filter;
 pub mod gnss;
 pub mod ins;
+pub mod ros;
 pub mod sim;

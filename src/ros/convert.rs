@@ -1,0 +1,621 @@
+//! Wire messages -> core types, and ROS time <-> `f64` seconds.
+//!
+//! Conversions only: no filter math, and no frame rotation. In particular the IMU
+//! vectors stay in the IMU's own frame (`header.frame_id`); the engine rotates them into
+//! the body frame from the configured mounting.
+
+use nalgebra::Vector3;
+
+use super::msg::{GnssMeasurements, Imu, SatelliteMeasurement, Time};
+use crate::gnss::{Constellation, GnssEpoch, Klobuchar, SatId, SatObservation};
+use crate::ins::ImuSample;
+
+/// Nanoseconds in one second.
+const NANOS_PER_SECOND: u32 = 1_000_000_000;
+/// Length of a GPS week (s).
+const SECONDS_PER_WEEK: f64 = 604_800.0;
+
+/// Why a wire message could not become a core value.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ConvertError {
+    /// A stamp whose nanoseconds are outside [0, 1e9).
+    #[error("stamp {sec} s + {nanosec} ns is not a valid ROS time: nanosec must be below 1e9")]
+    InvalidStamp {
+        /// Seconds field of the stamp.
+        sec: i32,
+        /// Nanoseconds field of the stamp.
+        nanosec: u32,
+    },
+    /// A time in seconds that no ROS stamp can hold.
+    #[error("{t_s} s cannot be a ROS time: it must be finite and its seconds fit in an int32")]
+    TimeOutOfRange {
+        /// The rejected time (s).
+        t_s: f64,
+    },
+    /// A GPS time of week that is not finite or not within one week.
+    #[error("GNSS epoch at {t_s} s: GPS time of week {tow_s} s is outside [0, 604800)")]
+    InvalidTimeOfWeek {
+        /// Stamp of the epoch (s).
+        t_s: f64,
+        /// The rejected time of week (s).
+        tow_s: f64,
+    },
+    /// A satellite whose constellation code is none of the message's constants.
+    #[error("GNSS epoch at {t_s} s: satellite #{index} (PRN {prn}) has unknown constellation code {code}")]
+    UnknownConstellation {
+        /// Stamp of the epoch (s).
+        t_s: f64,
+        /// Position of the satellite in the message's list.
+        index: usize,
+        /// The rejected constellation code.
+        code: u8,
+        /// PRN of the satellite.
+        prn: u16,
+    },
+    /// A satellite field whose value breaks the message's contract.
+    #[error("GNSS epoch at {t_s} s, satellite {sat}: {field} = {value}, expected {expected}")]
+    InvalidSatelliteField {
+        /// Stamp of the epoch (s).
+        t_s: f64,
+        /// The satellite.
+        sat: SatId,
+        /// Name of the field in `SatelliteMeasurement.msg`.
+        field: &'static str,
+        /// The rejected value.
+        value: f64,
+        /// What the contract allows.
+        expected: &'static str,
+    },
+    /// An IMU vector with a NaN or infinite component.
+    #[error("IMU sample at {t_s} s: {field} = {value:?} is not finite")]
+    NonFiniteImu {
+        /// Stamp of the sample (s).
+        t_s: f64,
+        /// Name of the field in `sensor_msgs/Imu`.
+        field: &'static str,
+        /// The rejected vector (x, y, z).
+        value: [f64; 3],
+    },
+}
+
+/// Seconds of a ROS stamp as `f64`: `sec + nanosec / 1e9`.
+///
+/// Math note: `sec` and `nanosec` are exact in `f64` and `nanosec / 1e9` is correctly
+/// rounded, so the sum carries one rounding: the result is within half an ulp (plus a
+/// negligible 1e-17 s) of the exact stamp. That is below 0.5 ns for stamps under 2^23 s
+/// (97 days: simulation and bag-relative times), so those come back exactly through
+/// [`seconds_to_time`]; for UNIX stamps of today (2^30..2^31 s) an `f64` resolves 238 ns
+/// and the error is at most 119 ns. Multiplying a total of nanoseconds by 1e-9 instead
+/// would add a second rounding of a 1.7e18 ns integer (256 ns apart in `f64`).
+pub fn time_to_seconds(stamp: &Time) -> Result<f64, ConvertError> {
+    if stamp.nanosec >= NANOS_PER_SECOND {
+        return Err(ConvertError::InvalidStamp {
+            sec: stamp.sec,
+            nanosec: stamp.nanosec,
+        });
+    }
+    Ok(f64::from(stamp.sec) + f64::from(stamp.nanosec) / f64::from(NANOS_PER_SECOND))
+}
+
+/// The ROS stamp nearest to `t_s` seconds (ties of the nanosecond rounding away from 0).
+///
+/// Math note: the whole seconds are split off first, `fraction = t_s - floor(t_s)` is
+/// exact (Sterbenz: `floor(t_s)` is within a factor 2 of `t_s` when |t_s| >= 1, and the
+/// subtraction is trivial below), and only the fraction is scaled to nanoseconds, so the
+/// result is the nearest nanosecond to the exact value of `t_s`. Converting back with
+/// [`time_to_seconds`] returns `t_s` unchanged for |t_s| >= 2^23 s, where the `f64`
+/// spacing exceeds 1 ns.
+pub fn seconds_to_time(t_s: f64) -> Result<Time, ConvertError> {
+    if !t_s.is_finite() {
+        return Err(ConvertError::TimeOutOfRange { t_s });
+    }
+    let whole_s = t_s.floor();
+    let fraction_s = t_s - whole_s;
+    let nanos = (fraction_s * f64::from(NANOS_PER_SECOND)).round();
+    // The rounding may reach a whole second (e.g. t_s = 0.9999999999).
+    let (sec, nanos) = if nanos >= f64::from(NANOS_PER_SECOND) {
+        (whole_s + 1.0, 0.0)
+    } else {
+        (whole_s, nanos)
+    };
+    if sec < f64::from(i32::MIN) || sec > f64::from(i32::MAX) {
+        return Err(ConvertError::TimeOutOfRange { t_s });
+    }
+    // Both casts are exact: `sec` is an integer within i32, `nanos` an integer in [0, 1e9).
+    Ok(Time {
+        sec: sec as i32,
+        nanosec: nanos as u32,
+    })
+}
+
+/// Converts one epoch of raw measurements.
+///
+/// - `t_s` is `header.stamp` in seconds; the GPS time of week must lie in [0, 604800).
+/// - NaN in an optional field (rate, sigmas, C/N0, atmospheric delays) becomes `None`;
+///   an infinite value there, or a sigma that is not positive, is an error.
+/// - Choice: the pseudo-range and the satellite's position, velocity, clock bias and
+///   drift are required (the core type cannot say "absent"): a non-finite value there
+///   rejects the whole epoch with an error naming the satellite, rather than passing a
+///   NaN into the filter.
+/// - The Klobuchar coefficients are kept only when all eight are finite (NaN = not
+///   broadcast; a partial set is unusable).
+/// - `gps_week` is not carried: the core needs only the time of week.
+impl TryFrom<&GnssMeasurements> for GnssEpoch {
+    type Error = ConvertError;
+
+    fn try_from(msg: &GnssMeasurements) -> Result<Self, Self::Error> {
+        let t_s = time_to_seconds(&msg.header.stamp)?;
+        let tow_s = msg.gps_time_of_week_s;
+        if !(0.0..SECONDS_PER_WEEK).contains(&tow_s) {
+            return Err(ConvertError::InvalidTimeOfWeek { t_s, tow_s });
+        }
+        let satellites = msg
+            .satellites
+            .iter()
+            .enumerate()
+            .map(|(index, sat)| sat_observation(t_s, index, sat))
+            .collect::<Result<Vec<_>, _>>()?;
+        let all_finite = msg
+            .klobuchar_alpha
+            .iter()
+            .chain(msg.klobuchar_beta.iter())
+            .all(|c| c.is_finite());
+        let klobuchar = all_finite.then_some(Klobuchar {
+            alpha: msg.klobuchar_alpha,
+            beta: msg.klobuchar_beta,
+        });
+        Ok(GnssEpoch {
+            t_s,
+            gps_time_of_week_s: tow_s,
+            satellites,
+            klobuchar,
+        })
+    }
+}
+
+/// Converts the satellite at `index` of an epoch stamped `t_s`.
+fn sat_observation(
+    t_s: f64,
+    index: usize,
+    m: &SatelliteMeasurement,
+) -> Result<SatObservation, ConvertError> {
+    let constellation =
+        Constellation::from_code(m.constellation).ok_or(ConvertError::UnknownConstellation {
+            t_s,
+            index,
+            code: m.constellation,
+            prn: m.prn,
+        })?;
+    let sat = SatId {
+        constellation,
+        prn: m.prn,
+    };
+    let check = FieldCheck { t_s, sat };
+    let pos = &m.satellite_position_ecef_m;
+    let vel = &m.satellite_velocity_ecef_mps;
+    Ok(SatObservation {
+        sat,
+        pseudorange_m: check.required("pseudorange_m", m.pseudorange_m)?,
+        pseudorange_rate_mps: check.optional("pseudorange_rate_mps", m.pseudorange_rate_mps)?,
+        pseudorange_sigma_m: check.sigma("pseudorange_sigma_m", m.pseudorange_sigma_m)?,
+        pseudorange_rate_sigma_mps: check
+            .sigma("pseudorange_rate_sigma_mps", m.pseudorange_rate_sigma_mps)?,
+        cn0_dbhz: check.optional("cn0_dbhz", f64::from(m.cn0_dbhz))?,
+        sat_pos_ecef_m: Vector3::new(
+            check.required("satellite_position_ecef_m.x", pos.x)?,
+            check.required("satellite_position_ecef_m.y", pos.y)?,
+            check.required("satellite_position_ecef_m.z", pos.z)?,
+        ),
+        sat_vel_ecef_mps: Vector3::new(
+            check.required("satellite_velocity_ecef_mps.x", vel.x)?,
+            check.required("satellite_velocity_ecef_mps.y", vel.y)?,
+            check.required("satellite_velocity_ecef_mps.z", vel.z)?,
+        ),
+        sat_clock_bias_s: check.required("satellite_clock_bias_s", m.satellite_clock_bias_s)?,
+        sat_clock_drift_s_s: check
+            .required("satellite_clock_drift_s_s", m.satellite_clock_drift_s_s)?,
+        iono_delay_m: check.optional("ionosphere_delay_m", m.ionosphere_delay_m)?,
+        tropo_delay_m: check.optional("troposphere_delay_m", m.troposphere_delay_m)?,
+    })
+}
+
+/// Checks the fields of one satellite, naming it in the errors.
+struct FieldCheck {
+    t_s: f64,
+    sat: SatId,
+}
+
+impl FieldCheck {
+    /// The error for `field = value`, which should have been `expected`.
+    fn error(&self, field: &'static str, value: f64, expected: &'static str) -> ConvertError {
+        ConvertError::InvalidSatelliteField {
+            t_s: self.t_s,
+            sat: self.sat,
+            field,
+            value,
+            expected,
+        }
+    }
+
+    /// A value that must be present and finite.
+    fn required(&self, field: &'static str, value: f64) -> Result<f64, ConvertError> {
+        if value.is_finite() {
+            Ok(value)
+        } else {
+            Err(self.error(field, value, "a finite number"))
+        }
+    }
+
+    /// A value that is NaN when absent (-> `None`), finite otherwise.
+    fn optional(&self, field: &'static str, value: f64) -> Result<Option<f64>, ConvertError> {
+        if value.is_nan() {
+            Ok(None)
+        } else if value.is_finite() {
+            Ok(Some(value))
+        } else {
+            Err(self.error(field, value, "a finite number or NaN (absent)"))
+        }
+    }
+
+    /// A 1σ that is NaN when unknown (-> `None`), positive and finite otherwise.
+    fn sigma(&self, field: &'static str, value: f64) -> Result<Option<f64>, ConvertError> {
+        if value.is_nan() {
+            Ok(None)
+        } else if value.is_finite() && value > 0.0 {
+            Ok(Some(value))
+        } else {
+            Err(self.error(field, value, "a positive finite 1-sigma or NaN (unknown)"))
+        }
+    }
+}
+
+/// Converts a REP-145 IMU message: `angular_velocity` (rad/s) and `linear_acceleration`
+/// (specific force, m/s²) taken as given, `t_s` from `header.stamp`. The orientation and
+/// covariances are not used.
+///
+/// Choice: the vectors stay in the IMU frame `header.frame_id`; the engine rotates them
+/// into the body frame from the configured mounting before mechanization.
+impl TryFrom<&Imu> for ImuSample {
+    type Error = ConvertError;
+
+    fn try_from(imu: &Imu) -> Result<Self, Self::Error> {
+        let t_s = time_to_seconds(&imu.header.stamp)?;
+        let finite = |field: &'static str, v: &super::msg::Vector3| {
+            let value = [v.x, v.y, v.z];
+            if value.iter().all(|c| c.is_finite()) {
+                Ok(Vector3::from(value))
+            } else {
+                Err(ConvertError::NonFiniteImu { t_s, field, value })
+            }
+        };
+        Ok(ImuSample {
+            t_s,
+            w_ib_b_rad_s: finite("angular_velocity", &imu.angular_velocity)?,
+            f_ib_b_m_s2: finite("linear_acceleration", &imu.linear_acceleration)?,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use proptest::prelude::*;
+
+    use super::*;
+    use crate::ros::msg::{Header, Point, SatelliteMeasurement};
+
+    /// `(m, e)` with `v = m * 2^e` exactly, for a normal positive `v`.
+    fn decompose(v: f64) -> (i128, i32) {
+        let bits = v.to_bits();
+        let mantissa = (bits & ((1 << 52) - 1)) | (1 << 52);
+        let exponent = ((bits >> 52) & 0x7ff) as i32 - 1075;
+        (i128::from(mantissa), exponent)
+    }
+
+    /// `m * 1e9 - total_ns * 2^-e`: the error of `v` against `total_ns` nanoseconds,
+    /// in units of 2^e ns, computed exactly in integers (needs -52 <= e <= 0).
+    fn scaled_error(v: f64, total_ns: i128) -> (i128, i32) {
+        let (m, e) = decompose(v);
+        assert!((-52..=0).contains(&e), "test helper needs 1 <= v < 2^53");
+        (m * 1_000_000_000 - (total_ns << -e), e)
+    }
+
+    fn total_ns(t: &Time) -> i128 {
+        i128::from(t.sec) * 1_000_000_000 + i128::from(t.nanosec)
+    }
+
+    #[test]
+    fn stamp_to_seconds_is_correctly_rounded() {
+        // Reference: Python float(Fraction(1700000123456789012, 10**9)).
+        let t = Time {
+            sec: 1_700_000_123,
+            nanosec: 456_789_012,
+        };
+        assert_eq!(
+            time_to_seconds(&t).unwrap(),
+            f64::from_bits(0x41d9_54fc_5edd_3c08)
+        );
+        let negative = Time {
+            sec: -4,
+            nanosec: 250_000_000,
+        };
+        assert_eq!(time_to_seconds(&negative).unwrap(), -3.75);
+    }
+
+    #[test]
+    fn seconds_to_stamp_is_the_nearest_nanosecond() {
+        // t = 1700000123.456789016723...: the f64 nearest to 1700000123.456789012.
+        // Reference: Python round((Fraction(t) - 1700000123) * 10**9) = 456789017, where
+        // the naive int(t * 1e9) is 25 ns off (456788992).
+        let t = seconds_to_time(1_700_000_123.456_789).unwrap();
+        assert_eq!(
+            t,
+            Time {
+                sec: 1_700_000_123,
+                nanosec: 456_789_017
+            }
+        );
+        let t = seconds_to_time(12_345.000_000_001).unwrap();
+        assert_eq!((t.sec, t.nanosec), (12_345, 1));
+        let t = seconds_to_time(-1.25).unwrap();
+        assert_eq!((t.sec, t.nanosec), (-2, 750_000_000));
+        // Rounds up to a whole second: the carry goes into `sec`.
+        let t = seconds_to_time(0.999_999_999_9).unwrap();
+        assert_eq!((t.sec, t.nanosec), (1, 0));
+        let t = seconds_to_time(-1e-20).unwrap();
+        assert_eq!((t.sec, t.nanosec), (0, 0));
+    }
+
+    #[test]
+    fn times_outside_the_stamp_range_are_errors() {
+        assert_eq!(
+            seconds_to_time(f64::from(i32::MIN)).unwrap(),
+            Time {
+                sec: i32::MIN,
+                nanosec: 0
+            }
+        );
+        for t_s in [2_147_483_648.0, -2_147_483_649.0, f64::NAN, f64::INFINITY] {
+            assert!(matches!(
+                seconds_to_time(t_s),
+                Err(ConvertError::TimeOutOfRange { .. })
+            ));
+        }
+        let bad = Time {
+            sec: 1,
+            nanosec: 1_000_000_000,
+        };
+        assert_eq!(
+            time_to_seconds(&bad),
+            Err(ConvertError::InvalidStamp {
+                sec: 1,
+                nanosec: 1_000_000_000
+            })
+        );
+    }
+
+    proptest! {
+        /// Error of `time_to_seconds` <= half an ulp + 2^-54 s, checked exactly.
+        #[test]
+        fn time_to_seconds_error_is_within_half_an_ulp(sec in 1..i32::MAX, nanosec in 0..1_000_000_000u32) {
+            let t = Time { sec, nanosec };
+            let (diff, e) = scaled_error(time_to_seconds(&t).unwrap(), total_ns(&t));
+            // |diff| / (1e9 * 2^-e) s <= 2^(e-1) s + 2^-54 s.
+            let bound = 500_000_000 + ((1_000_000_000_i128 << -e) >> 54) + 1;
+            prop_assert!(diff.abs() <= bound, "diff {diff} > {bound}");
+        }
+
+        /// `seconds_to_time` gives the nanosecond nearest to the exact value of `t_s`.
+        #[test]
+        fn seconds_to_time_is_the_nearest_nanosecond(t_s in 1.0..2_147_483_647.0_f64) {
+            let t = seconds_to_time(t_s).unwrap();
+            let (diff, e) = scaled_error(t_s, total_ns(&t));
+            // |diff| * 2^e ns <= 0.5 ns, plus the rounding of fraction * 1e9.
+            let bound = (1_i128 << (-e - 1)) + ((1_i128 << -e) >> 20);
+            prop_assert!(diff.abs() <= bound, "diff {diff} > {bound}");
+        }
+
+        /// Below 2^23 s an f64 resolves the nanosecond: stamps survive the round trip.
+        #[test]
+        fn short_stamps_survive_the_round_trip(sec in -(1 << 23)..(1 << 23), nanosec in 0..1_000_000_000u32) {
+            let t = Time { sec, nanosec };
+            prop_assert_eq!(seconds_to_time(time_to_seconds(&t).unwrap()).unwrap(), t);
+        }
+
+        /// From 2^23 s on, the f64 spacing exceeds 1 ns: f64 times survive the round trip.
+        #[test]
+        fn long_times_survive_the_round_trip(t_s in 8_388_608.0..2_147_483_647.0_f64) {
+            prop_assert_eq!(time_to_seconds(&seconds_to_time(t_s).unwrap()).unwrap(), t_s);
+        }
+    }
+
+    fn gps_satellite() -> SatelliteMeasurement {
+        SatelliteMeasurement {
+            constellation: SatelliteMeasurement::GPS,
+            prn: 5,
+            pseudorange_m: 21_456_789.125,
+            pseudorange_rate_mps: -345.5,
+            pseudorange_sigma_m: 2.5,
+            pseudorange_rate_sigma_mps: 0.125,
+            cn0_dbhz: 45.25,
+            satellite_position_ecef_m: Point {
+                x: 15_600_000.5,
+                y: -7_540_000.25,
+                z: 20_140_000.75,
+            },
+            satellite_velocity_ecef_mps: crate::ros::msg::Vector3 {
+                x: -1_200.5,
+                y: 2_300.25,
+                z: 850.125,
+            },
+            satellite_clock_bias_s: 1.234e-4,
+            satellite_clock_drift_s_s: -5.6e-12,
+            ionosphere_delay_m: f64::NAN,
+            troposphere_delay_m: f64::NAN,
+        }
+    }
+
+    fn epoch_msg() -> GnssMeasurements {
+        GnssMeasurements {
+            header: Header {
+                stamp: Time {
+                    sec: 1000,
+                    nanosec: 500_000_000,
+                },
+                frame_id: "gnss".to_string(),
+            },
+            gps_week: 2288,
+            gps_time_of_week_s: 1000.5,
+            satellites: vec![gps_satellite(), gps_satellite()],
+            klobuchar_alpha: [1e-8, 2e-8, -6e-8, -6e-8],
+            klobuchar_beta: [9e4, 0.0, -2e5, -6e4],
+        }
+    }
+
+    fn field_error(msg: &GnssMeasurements) -> (String, &'static str) {
+        match GnssEpoch::try_from(msg) {
+            Err(ConvertError::InvalidSatelliteField { sat, field, .. }) => (sat.to_string(), field),
+            other => panic!("expected InvalidSatelliteField, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn a_clean_epoch_converts() {
+        let epoch = GnssEpoch::try_from(&epoch_msg()).unwrap();
+        assert_eq!(epoch.t_s, 1000.5);
+        assert_eq!(epoch.satellites.len(), 2);
+        let sat = &epoch.satellites[0];
+        assert_eq!(sat.sat.to_string(), "G05");
+        assert_eq!(sat.pseudorange_rate_sigma_mps, Some(0.125));
+        assert_eq!(sat.iono_delay_m, None);
+        assert_eq!(sat.sat_clock_drift_s_s, -5.6e-12);
+        assert_eq!(epoch.klobuchar.unwrap().beta[2], -2e5);
+    }
+
+    #[test]
+    fn unknown_constellation_names_the_satellite() {
+        let mut msg = epoch_msg();
+        msg.satellites[1].constellation = 9;
+        msg.satellites[1].prn = 33;
+        let err = GnssEpoch::try_from(&msg).unwrap_err();
+        assert_eq!(
+            err,
+            ConvertError::UnknownConstellation {
+                t_s: 1000.5,
+                index: 1,
+                code: 9,
+                prn: 33
+            }
+        );
+        assert!(err.to_string().contains("PRN 33"));
+    }
+
+    #[test]
+    fn non_finite_required_fields_name_the_satellite() {
+        let mut msg = epoch_msg();
+        msg.satellites[1].constellation = SatelliteMeasurement::GALILEO;
+        msg.satellites[1].prn = 12;
+        msg.satellites[1].pseudorange_m = f64::NAN;
+        assert_eq!(field_error(&msg), ("E12".to_string(), "pseudorange_m"));
+        let err = GnssEpoch::try_from(&msg).unwrap_err().to_string();
+        assert!(
+            err.contains("E12") && err.contains("pseudorange_m"),
+            "{err}"
+        );
+
+        let mut msg = epoch_msg();
+        msg.satellites[0].satellite_position_ecef_m.y = f64::INFINITY;
+        assert_eq!(
+            field_error(&msg),
+            ("G05".to_string(), "satellite_position_ecef_m.y")
+        );
+        let mut msg = epoch_msg();
+        msg.satellites[0].satellite_clock_bias_s = f64::NAN;
+        assert_eq!(
+            field_error(&msg),
+            ("G05".to_string(), "satellite_clock_bias_s")
+        );
+    }
+
+    #[test]
+    fn optional_fields_take_nan_but_not_infinity_or_bad_sigmas() {
+        let mut msg = epoch_msg();
+        msg.satellites[0].troposphere_delay_m = f64::NEG_INFINITY;
+        assert_eq!(field_error(&msg).1, "troposphere_delay_m");
+        let mut msg = epoch_msg();
+        msg.satellites[0].cn0_dbhz = f32::INFINITY;
+        assert_eq!(field_error(&msg).1, "cn0_dbhz");
+        for sigma in [0.0, -1.0, f64::INFINITY] {
+            let mut msg = epoch_msg();
+            msg.satellites[0].pseudorange_sigma_m = sigma;
+            assert_eq!(field_error(&msg).1, "pseudorange_sigma_m");
+        }
+        let mut msg = epoch_msg();
+        msg.satellites[0].pseudorange_rate_mps = f64::NAN;
+        msg.satellites[0].cn0_dbhz = f32::NAN;
+        let sat = &GnssEpoch::try_from(&msg).unwrap().satellites[0];
+        assert_eq!((sat.pseudorange_rate_mps, sat.cn0_dbhz), (None, None));
+    }
+
+    #[test]
+    fn klobuchar_needs_all_eight_coefficients() {
+        let mut msg = epoch_msg();
+        msg.klobuchar_beta[3] = f64::NAN;
+        assert_eq!(GnssEpoch::try_from(&msg).unwrap().klobuchar, None);
+    }
+
+    #[test]
+    fn time_of_week_outside_a_week_is_an_error() {
+        for tow_s in [-0.5, 604_800.0, f64::NAN] {
+            let mut msg = epoch_msg();
+            msg.gps_time_of_week_s = tow_s;
+            assert!(matches!(
+                GnssEpoch::try_from(&msg),
+                Err(ConvertError::InvalidTimeOfWeek { .. })
+            ));
+        }
+        let mut msg = epoch_msg();
+        msg.header.stamp.nanosec = 1_000_000_000;
+        assert!(matches!(
+            GnssEpoch::try_from(&msg),
+            Err(ConvertError::InvalidStamp { .. })
+        ));
+    }
+
+    fn imu_msg() -> Imu {
+        let mut imu = Imu::default();
+        imu.header.stamp = Time {
+            sec: 12,
+            nanosec: 250_000_000,
+        };
+        imu.angular_velocity.z = 0.5;
+        imu.linear_acceleration.z = 9.81;
+        imu
+    }
+
+    #[test]
+    fn imu_vectors_pass_unchanged() {
+        let sample = ImuSample::try_from(&imu_msg()).unwrap();
+        assert_eq!(sample.t_s, 12.25);
+        assert_eq!(sample.w_ib_b_rad_s, Vector3::new(0.0, 0.0, 0.5));
+        assert_eq!(sample.f_ib_b_m_s2, Vector3::new(0.0, 0.0, 9.81));
+    }
+
+    #[test]
+    fn non_finite_imu_vectors_are_errors() {
+        let mut imu = imu_msg();
+        imu.angular_velocity.y = f64::NAN;
+        assert!(matches!(
+            ImuSample::try_from(&imu),
+            Err(ConvertError::NonFiniteImu { field: "angular_velocity", t_s, .. }) if t_s == 12.25
+        ));
+        let mut imu = imu_msg();
+        imu.linear_acceleration.x = f64::NEG_INFINITY;
+        assert!(matches!(
+            ImuSample::try_from(&imu),
+            Err(ConvertError::NonFiniteImu {
+                field: "linear_acceleration",
+                ..
+            })
+        ));
+    }
+}

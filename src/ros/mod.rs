@@ -1,0 +1,12 @@
+//! The ROS 2 side of the crate: wire messages, their CDR encoding and their conversion
+//! into the core types. Nothing in here holds filter math.
+//!
+//! - [`msg`]: serde structs byte-identical (in CDR) to the ROS 2 Jazzy messages the node
+//!   uses, plus the package's own messages of `msg/`.
+//! - [`cdr`]: `encode` / `decode` of a whole serialized ROS 2 payload (encapsulation
+//!   header + CDR body).
+//! - [`convert`]: wire messages -> core types (`GnssEpoch`, `ImuSample`) and ROS time.
+
+pub mod cdr;
+pub mod convert;
+pub mod msg;

@@ -1,0 +1,266 @@
+#!/usr/bin/env python3
+"""Writes tests/data/cdr/*.cdr: one ROS 2 CDR payload per message type, serialized by
+the independent pure-Python `rosbags` library (ROS 2 Jazzy type store plus this
+package's msg/ definitions). tests/cdr_fixtures.rs builds the same values in Rust and
+checks that our encoder reproduces these bytes exactly and our decoder reads them back.
+
+Usage (from the crate root, in a throw-away virtual environment outside the repo):
+    python3 -m venv "$HOME/venv_fixtures"
+    "$HOME/venv_fixtures/bin/pip" install -r tools/requirements-test-peers.txt
+    "$HOME/venv_fixtures/bin/python" tools/make_cdr_fixtures.py
+
+The values are distinctive (no zeros where a field could be confused with padding, odd
+string lengths, a negative int8, NaN where the contract allows it) and MUST stay in step
+with tests/cdr_fixtures.rs.
+"""
+
+from pathlib import Path
+
+import numpy as np
+from rosbags.typesys import Stores, get_typestore, get_types_from_msg
+
+CRATE_ROOT = Path(__file__).resolve().parent.parent
+MSG_DIR = CRATE_ROOT / "msg"
+OUT_DIR = CRATE_ROOT / "tests" / "data" / "cdr"
+PACKAGE = "adaptive_gnss_ins"
+OWN_MESSAGES = ["SatelliteMeasurement", "GnssMeasurements", "SatelliteNoise", "NoiseEstimates"]
+NAN = float("nan")
+
+
+def make_typestore():
+    """ROS 2 Jazzy types plus this package's messages read from msg/."""
+    store = get_typestore(Stores.ROS2_JAZZY)
+    types = {}
+    for name in OWN_MESSAGES:
+        text = (MSG_DIR / f"{name}.msg").read_text(encoding="utf-8")
+        types.update(get_types_from_msg(text, f"{PACKAGE}/msg/{name}"))
+    store.register(types)
+    return store
+
+
+def seq(start, count, step):
+    """float64 array start, start + step, ... (count elements)."""
+    return np.array([start + i * step for i in range(count)], dtype=np.float64)
+
+
+def build_messages(ts):
+    """(fixture name, ROS type name, message) for every fixture."""
+    T = ts.types
+    Time = T["builtin_interfaces/msg/Time"]
+    Header = T["std_msgs/msg/Header"]
+    Point = T["geometry_msgs/msg/Point"]
+    Vector3 = T["geometry_msgs/msg/Vector3"]
+    Quaternion = T["geometry_msgs/msg/Quaternion"]
+    Pose = T["geometry_msgs/msg/Pose"]
+    Twist = T["geometry_msgs/msg/Twist"]
+    Transform = T["geometry_msgs/msg/Transform"]
+
+    imu = T["sensor_msgs/msg/Imu"](
+        header=Header(stamp=Time(sec=1_700_000_123, nanosec=456_789_012), frame_id="imu_link"),
+        orientation=Quaternion(x=0.1, y=-0.2, z=0.3, w=0.9),
+        orientation_covariance=seq(1.5, 9, 0.25),
+        angular_velocity=Vector3(x=0.01, y=-0.02, z=0.5),
+        angular_velocity_covariance=seq(1e-6, 9, 1e-7),
+        linear_acceleration=Vector3(x=0.3, y=-0.4, z=9.81),
+        linear_acceleration_covariance=seq(2e-3, 9, 1e-4),
+    )
+
+    nav_sat_status = T["sensor_msgs/msg/NavSatStatus"]
+    nav_sat_fix = T["sensor_msgs/msg/NavSatFix"](
+        header=Header(stamp=Time(sec=1_700_000_200, nanosec=5), frame_id="gnss"),
+        status=nav_sat_status(status=-1, service=1 | 8),
+        latitude=48.137154,
+        longitude=11.576124,
+        altitude=519.25,
+        position_covariance=seq(0.5, 9, 0.125),
+        position_covariance_type=2,
+    )
+
+    odometry = T["nav_msgs/msg/Odometry"](
+        header=Header(stamp=Time(sec=42, nanosec=999_999_999), frame_id="map"),
+        child_frame_id="base_link",
+        pose=T["geometry_msgs/msg/PoseWithCovariance"](
+            pose=Pose(
+                position=Point(x=12.5, y=-7.25, z=0.75),
+                orientation=Quaternion(x=0.0, y=0.0, z=0.38268343236508984, w=0.9238795325112867),
+            ),
+            covariance=seq(0.01, 36, 0.01),
+        ),
+        twist=T["geometry_msgs/msg/TwistWithCovariance"](
+            twist=Twist(linear=Vector3(x=3.5, y=0.25, z=-0.125), angular=Vector3(x=0.0, y=0.0, z=0.0625)),
+            covariance=seq(-1.0, 36, 0.5),
+        ),
+    )
+
+    KeyValue = T["diagnostic_msgs/msg/KeyValue"]
+    DiagnosticStatus = T["diagnostic_msgs/msg/DiagnosticStatus"]
+    diagnostic_array = T["diagnostic_msgs/msg/DiagnosticArray"](
+        header=Header(stamp=Time(sec=1_700_000_300, nanosec=1), frame_id=""),
+        status=[
+            DiagnosticStatus(
+                level=1,
+                name="gnss_ins: filter",
+                message="innovation gate hit 3×",
+                hardware_id="ubx-f9p",
+                values=[
+                    KeyValue(key="nis", value="12.5"),
+                    KeyValue(key="satellites_used", value="7"),
+                    KeyValue(key="elevation_mask_°", value=""),
+                ],
+            ),
+            DiagnosticStatus(level=3, name="imu", message="stale", hardware_id="", values=[]),
+        ],
+    )
+
+    TransformStamped = T["geometry_msgs/msg/TransformStamped"]
+    tf_message = T["tf2_msgs/msg/TFMessage"](
+        transforms=[
+            TransformStamped(
+                header=Header(stamp=Time(sec=100, nanosec=200), frame_id="odom"),
+                child_frame_id="base_link",
+                transform=Transform(
+                    translation=Vector3(x=1.0, y=2.0, z=3.0),
+                    rotation=Quaternion(x=0.5, y=-0.5, z=0.5, w=-0.5),
+                ),
+            ),
+            TransformStamped(
+                header=Header(stamp=Time(sec=101, nanosec=300), frame_id="map"),
+                child_frame_id="odom",
+                transform=Transform(
+                    translation=Vector3(x=-4.5, y=0.125, z=6.0),
+                    rotation=Quaternion(x=0.0, y=0.0, z=0.0, w=1.0),
+                ),
+            ),
+        ]
+    )
+
+    clock = T["rosgraph_msgs/msg/Clock"](clock=Time(sec=-3, nanosec=750_000_000))
+
+    twist_stamped = T["geometry_msgs/msg/TwistWithCovarianceStamped"](
+        header=Header(stamp=Time(sec=7, nanosec=8), frame_id="gnss_antenna"),
+        twist=T["geometry_msgs/msg/TwistWithCovariance"](
+            twist=Twist(linear=Vector3(x=-1.5, y=2.5, z=0.05), angular=Vector3(x=0.1, y=0.2, z=0.3)),
+            covariance=seq(100.0, 36, -2.5),
+        ),
+    )
+
+    Sat = T[f"{PACKAGE}/msg/SatelliteMeasurement"]
+    gnss_measurements = T[f"{PACKAGE}/msg/GnssMeasurements"](
+        header=Header(stamp=Time(sec=1_700_000_400, nanosec=100_000_000), frame_id="gnss_antenna"),
+        gps_week=2288,
+        gps_time_of_week_s=345_618.1,
+        satellites=[
+            Sat(
+                constellation=1,
+                prn=5,
+                pseudorange_m=21_456_789.125,
+                pseudorange_rate_mps=-345.5,
+                pseudorange_sigma_m=2.5,
+                pseudorange_rate_sigma_mps=0.125,
+                cn0_dbhz=45.25,
+                satellite_position_ecef_m=Point(x=15_600_000.5, y=-7_540_000.25, z=20_140_000.75),
+                satellite_velocity_ecef_mps=Vector3(x=-1_200.5, y=2_300.25, z=850.125),
+                satellite_clock_bias_s=1.234e-4,
+                satellite_clock_drift_s_s=-5.6e-12,
+                ionosphere_delay_m=NAN,
+                troposphere_delay_m=2.375,
+            ),
+            Sat(
+                constellation=3,
+                prn=27,
+                pseudorange_m=23_987_654.5,
+                pseudorange_rate_mps=NAN,
+                pseudorange_sigma_m=NAN,
+                pseudorange_rate_sigma_mps=NAN,
+                cn0_dbhz=NAN,
+                satellite_position_ecef_m=Point(x=-12_000_000.0, y=18_500_000.0, z=-17_250_000.5),
+                satellite_velocity_ecef_mps=Vector3(x=2_100.0, y=-300.75, z=-1_500.5),
+                satellite_clock_bias_s=-3.21e-5,
+                satellite_clock_drift_s_s=1.5e-12,
+                ionosphere_delay_m=NAN,
+                troposphere_delay_m=NAN,
+            ),
+        ],
+        klobuchar_alpha=np.array([1.1176e-8, 7.4506e-9, -5.9605e-8, -5.9605e-8]),
+        klobuchar_beta=np.array([90112.0, 0.0, -196608.0, -65536.0]),
+    )
+
+    Noise = T[f"{PACKAGE}/msg/SatelliteNoise"]
+    noise_estimates = T[f"{PACKAGE}/msg/NoiseEstimates"](
+        header=Header(stamp=Time(sec=1_700_000_400, nanosec=100_000_000), frame_id="gnss_antenna"),
+        filter_variant="ermakf",
+        satellites=[
+            Noise(
+                constellation=1,
+                prn=5,
+                elevation_deg=43.5,
+                used=True,
+                rejection_reason=0,
+                innovation_pseudorange_m=1.75,
+                innovation_pseudorange_rate_mps=-0.0625,
+                normalized_innovation_pseudorange=0.7,
+                normalized_innovation_pseudorange_rate=-0.5,
+                r_pseudorange_m2=6.25,
+                r_pseudorange_rate_m2_s2=0.015625,
+                kde_credibility=0.0123,
+                gaussian=True,
+                ar_order=3,
+                robust_weight=1.0,
+            ),
+            Noise(
+                constellation=3,
+                prn=27,
+                elevation_deg=7.25,
+                used=False,
+                rejection_reason=1,
+                innovation_pseudorange_m=NAN,
+                innovation_pseudorange_rate_mps=NAN,
+                normalized_innovation_pseudorange=NAN,
+                normalized_innovation_pseudorange_rate=NAN,
+                r_pseudorange_m2=NAN,
+                r_pseudorange_rate_m2_s2=NAN,
+                kde_credibility=NAN,
+                gaussian=False,
+                ar_order=0,
+                robust_weight=NAN,
+            ),
+        ],
+        adaptive_factor=0.85,
+        mahalanobis_d2=9.5,
+        chi2_threshold=15.507,
+        q_scale=1.25,
+        nis=7.75,
+    )
+
+    return [
+        ("imu", "sensor_msgs/msg/Imu", imu),
+        ("nav_sat_fix", "sensor_msgs/msg/NavSatFix", nav_sat_fix),
+        ("odometry", "nav_msgs/msg/Odometry", odometry),
+        ("diagnostic_array", "diagnostic_msgs/msg/DiagnosticArray", diagnostic_array),
+        ("tf_message", "tf2_msgs/msg/TFMessage", tf_message),
+        ("clock", "rosgraph_msgs/msg/Clock", clock),
+        ("twist_with_covariance_stamped", "geometry_msgs/msg/TwistWithCovarianceStamped", twist_stamped),
+        ("gnss_measurements", f"{PACKAGE}/msg/GnssMeasurements", gnss_measurements),
+        ("noise_estimates", f"{PACKAGE}/msg/NoiseEstimates", noise_estimates),
+    ]
+
+
+# Fixtures also written big-endian (CDR_BE), to prove the decoder reads that encapsulation.
+BIG_ENDIAN_TOO = {"imu", "gnss_measurements"}
+
+
+def main():
+    ts = make_typestore()
+    OUT_DIR.mkdir(parents=True, exist_ok=True)
+    for name, typename, message in build_messages(ts):
+        payload = bytes(ts.serialize_cdr(message, typename, little_endian=True))
+        (OUT_DIR / f"{name}.cdr").write_bytes(payload)
+        print(f"{name}.cdr: {typename}, {len(payload)} bytes")
+        if name in BIG_ENDIAN_TOO:
+            payload_be = bytes(ts.serialize_cdr(message, typename, little_endian=False))
+            (OUT_DIR / f"{name}_be.cdr").write_bytes(payload_be)
+            print(f"{name}_be.cdr: {typename}, {len(payload_be)} bytes (CDR_BE)")
+
+
+if __name__ == "__main__":
+    main()
