@@ -19,3 +19,4 @@
 pub mod earth;
 pub mod gnss;
 pub mod ins;
+pub mod sim;
