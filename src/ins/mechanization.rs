@@ -6,10 +6,10 @@
 //!
 //! 1. coning: φ_b = Δθ_k + (1/12) Δθ_{k−1} × Δθ_k, the rotation vector of b(t_k) relative
 //!    to b(t_{k−1}) (inertially);
-//! 2. velocity: Δv_sf^b = Δv_k + ½ Δθ_k × Δv_k + (1/6) Δθ_k × (Δθ_k × Δv_k)
-//!    + (1/12)(Δθ_{k−1} × Δv_k + Δv_{k−1} × Δθ_k) (rotation compensation to third order
-//!    plus sculling), rotated with C_b^n(t_{k−1}) and the half
-//!    navigation-frame rotation [I − ½ ζ×]; gravity and Coriolis are added at mid-interval;
+//! 2. velocity: Δv_sf^b = Δv_k + ½ Δθ_k × Δv_k + (1/6) Δθ_k × (Δθ_k × Δv_k) +
+//!    (1/12)(Δθ_{k−1} × Δv_k + Δv_{k−1} × Δθ_k) (rotation compensation to third order
+//!    plus sculling), rotated with C_b^n(t_{k−1}) and the half navigation-frame rotation
+//!    [I − ½ ζ×]; gravity and Coriolis are added at mid-interval;
 //! 3. position: trapezoidal in (lat, lon, h) with mid-point radii of curvature;
 //! 4. attitude: C_b^n(t_k) = C_{n(k−1)}^{n(k)} C_b^n(t_{k−1}) C_{b(k)}^{b(k−1)} with
 //!    C_{b(k)}^{b(k−1)} = exp(φ_b×) and C_{n(k−1)}^{n(k)} = exp(−ζ×), ζ = ω_in^n Δt.

@@ -37,6 +37,9 @@ const MAX_ABS_LAT_DEG: f64 = 85.0;
 /// Largest |climb angle| (deg). Choice: vehicle-like and far from θ = ±90°, where yaw is
 /// undefined.
 const MAX_ABS_CLIMB_DEG: f64 = 45.0;
+/// Longest trajectory (s). Choice: one day, so the stored checkpoints (one per 0.1 s) stay
+/// around 20 MB whatever the spec says.
+const MAX_DURATION_S: f64 = 86_400.0;
 
 /// One piece of a trajectory. YAML form (internally tagged), e.g.
 /// `{ kind: turn, duration_s: 15.0, yaw_change_deg: 90.0 }`.
@@ -123,6 +126,9 @@ pub enum TrajectoryError {
     /// The trajectory leaves the allowed latitude band (or its integration failed).
     #[error("trajectory reaches latitude {lat_deg}° at t = {t_s} s (limit ±85°)")]
     LatitudeOutOfRange { t_s: f64, lat_deg: f64 },
+    /// The segments add up to more than a day.
+    #[error("trajectory lasts {duration_s} s, more than the {max_s} s allowed")]
+    TooLong { duration_s: f64, max_s: f64 },
     /// A time outside [start, end] was asked for.
     #[error("t = {t_s} s is outside the trajectory [{start_t_s}, {end_t_s}] s")]
     TimeOutOfRange {
@@ -292,6 +298,13 @@ impl Trajectory {
         }
         if plans.is_empty() {
             return Err(TrajectoryError::NoSegments);
+        }
+        let duration_s = t - spec.start_t_s;
+        if duration_s > MAX_DURATION_S {
+            return Err(TrajectoryError::TooLong {
+                duration_s,
+                max_s: MAX_DURATION_S,
+            });
         }
         let mut traj = Self {
             start_t_s: spec.start_t_s,
@@ -714,6 +727,12 @@ mod tests {
             climb_angle_deg: 60.0,
         });
         assert!(Trajectory::new(&s).is_err());
+        let mut s = spec();
+        s.segments.push(Segment::Cruise { duration_s: 1e9 });
+        assert!(matches!(
+            Trajectory::new(&s),
+            Err(TrajectoryError::TooLong { .. })
+        ));
         let traj = Trajectory::new(&spec()).unwrap();
         assert!(matches!(
             traj.truth_at(99.0),
