@@ -52,10 +52,17 @@ fn rotation_from_rpy(rpy_deg: &[f64; 3]) -> UnitQuaternion<f64> {
     UnitQuaternion::from_euler_angles(roll, pitch, yaw)
 }
 
+/// Roll, pitch, yaw (deg) of `q`, rounded to 1e-12 deg.
+///
+/// Choice: the Euler angles recomputed from a quaternion carry rounding of about 1e-14 deg
+/// (20 comes back as 19.999999999999996). Rounding to 1e-12 deg (2e-14 rad, far below any
+/// mounting knowledge) gives back the angles as they were written, so the echo reads as
+/// the file did and loading it reproduces the same quaternion.
 fn rpy_deg_from_rotation(q: &UnitQuaternion<f64>) -> [f64; 3] {
+    const STEPS_PER_DEG: f64 = 1e12;
     let (roll, pitch, yaw) = q.euler_angles();
     // `+ 0.0` turns a -0.0 into 0.0 so the echo of the identity reads [0.0, 0.0, 0.0].
-    [roll, pitch, yaw].map(|rad| si_to_human(rad, RAD_PER_DEG) + 0.0)
+    [roll, pitch, yaw].map(|rad| (rad / RAD_PER_DEG * STEPS_PER_DEG).round() / STEPS_PER_DEG + 0.0)
 }
 
 impl From<&RawConfig> for Config {
@@ -278,8 +285,10 @@ mod tests {
         let expected = rz * ry * rx;
         let diff = q.to_rotation_matrix().matrix() - expected.matrix();
         assert!(diff.amax() < 1e-15, "{diff}");
-        let back = rpy_deg_from_rotation(&q);
-        for (a, b) in back.iter().zip(rpy_deg) {
+        assert_eq!(rpy_deg_from_rotation(&q), rpy_deg);
+        let odd = [1.0 / 3.0, -89.0 / 7.0, 179.0 - 1.0 / 9.0];
+        let back = rpy_deg_from_rotation(&rotation_from_rpy(&odd));
+        for (a, b) in back.iter().zip(odd) {
             assert!((a - b).abs() < 1e-12, "{back:?}");
         }
     }

@@ -27,7 +27,7 @@ pub fn parameters_of(document: &Value, origin: &str) -> Result<Mapping, ConfigEr
     let mut entries = nodes.iter();
     let (node, node_value) = match (entries.next(), entries.next()) {
         (Some((node, value)), None) if node.is_string() => (node, value),
-        _ => return Err(layout_error(format!("top-level keys {}", key_list(nodes)))),
+        _ => return Err(layout_error(format!("top-level {}", keys_phrase(nodes)))),
     };
     let node_name = node.as_str().unwrap_or_default();
     let inner = match node_value {
@@ -187,6 +187,14 @@ fn key_list(mapping: &Mapping) -> String {
     names.join(", ")
 }
 
+fn keys_phrase(mapping: &Mapping) -> String {
+    if mapping.is_empty() {
+        "no keys".to_owned()
+    } else {
+        format!("keys {}", key_list(mapping))
+    }
+}
+
 fn describe(value: &Value) -> String {
     match value {
         Value::Null => "nothing (null)".to_owned(),
@@ -194,7 +202,7 @@ fn describe(value: &Value) -> String {
         Value::Number(_) => "a number".to_owned(),
         Value::String(_) => "a string".to_owned(),
         Value::Sequence(_) => "a list".to_owned(),
-        Value::Mapping(m) => format!("a mapping with keys {}", key_list(m)),
+        Value::Mapping(m) => format!("a mapping with {}", keys_phrase(m)),
         Value::Tagged(_) => "a tagged value".to_owned(),
     }
 }

@@ -162,7 +162,7 @@ fn validate_constellations(raw: &RawConfig, c: &Checker) -> Result<(), ConfigErr
     } else if names
         .iter()
         .enumerate()
-        .any(|(i, n)| names[..i].contains(n))
+        .any(|(i, n)| names.iter().take(i).any(|earlier| earlier == n))
     {
         "each constellation may be listed only once"
     } else {

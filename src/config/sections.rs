@@ -1,0 +1,212 @@
+//! The validated configuration in SI units and radians: what the engine reads. Each field
+//! names the parameter-file key it comes from and that key's default.
+
+use nalgebra::{UnitQuaternion, Vector3};
+use serde::Deserialize;
+
+use crate::earth::Llh;
+use crate::gnss::Constellation;
+
+/// The validated configuration, in SI units and radians.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Config {
+    pub filter: FilterConfig,
+    pub imu: ImuConfig,
+    pub mounting: MountingConfig,
+    pub clock: ClockConfig,
+    pub gnss: GnssConfig,
+    pub loose: LooseConfig,
+    pub init: InitConfig,
+    pub engine: EngineConfig,
+    pub output: OutputConfig,
+}
+
+/// Which filter runs (`filter.variant`). Every variant shares the engine, the measurement
+/// models and the diagnostics, so variants can be compared on the same data.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FilterVariant {
+    /// `ekf`: error-state extended Kalman filter with the fixed noise of this file; the
+    /// baseline the adaptive variants are measured against.
+    Ekf,
+}
+
+impl FilterVariant {
+    /// The name used in the parameter file.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Ekf => "ekf",
+        }
+    }
+}
+
+/// What the filter takes from the receiver (`filter.coupling`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Coupling {
+    /// `tight`: per-satellite pseudo-ranges and pseudo-range rates.
+    Tight,
+    /// `loose`: the receiver's position (and velocity) fix.
+    Loose,
+}
+
+impl Coupling {
+    /// The name used in the parameter file.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Tight => "tight",
+            Self::Loose => "loose",
+        }
+    }
+}
+
+/// `filter.*`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FilterConfig {
+    /// `filter.variant` (default `ekf`).
+    pub variant: FilterVariant,
+    /// `filter.coupling` (default `tight`).
+    pub coupling: Coupling,
+    /// `filter.joseph_form` (default `true`): covariance update P = (I−KH)P(I−KH)ᵀ + KRKᵀ.
+    pub joseph_form: bool,
+}
+
+/// `imu.*`, in SI.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ImuConfig {
+    /// Gyro angle random walk (rad/√s) from `imu.gyro_arw_deg_per_sqrt_h` (default `0.012`).
+    pub gyro_arw_rad_per_sqrt_s: f64,
+    /// Initial 1σ of the constant gyro bias (rad/s) from `imu.gyro_bias_deg_per_h` (default `0.5`).
+    pub gyro_bias_sigma_rad_s: f64,
+    /// Steady-state 1σ of the Gauss-Markov gyro drift (rad/s) from
+    /// `imu.gyro_markov_sigma_deg_per_h` (default `0.5`).
+    pub gyro_markov_sigma_rad_s: f64,
+    /// Gyro drift correlation time (s), `imu.gyro_markov_correlation_time_s` (default `3600`).
+    pub gyro_markov_time_s: f64,
+    /// Accelerometer velocity random walk (m/s/√s) from `imu.accel_vrw_ug_per_sqrt_hz` (default
+    /// `100`).
+    pub accel_vrw_m_s_per_sqrt_s: f64,
+    /// Steady-state 1σ of the Gauss-Markov accelerometer bias (m/s²) from
+    /// `imu.accel_bias_ug` (default `1250`).
+    pub accel_bias_sigma_m_s2: f64,
+    /// Accelerometer bias correlation time (s), `imu.accel_bias_correlation_time_s` (default
+    /// `3600`).
+    pub accel_markov_time_s: f64,
+}
+
+/// `mounting.*`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MountingConfig {
+    /// Rotation taking IMU-frame vectors into the body frame (FLU): v_b = q · v_imu, from
+    /// `mounting.imu_rotation_rpy_deg` (default `[0, 0, 0]`) = `[roll, pitch, yaw]` about x, y, z
+    /// applied as R = Rz(yaw) · Ry(pitch) · Rx(roll).
+    pub imu_to_body: UnitQuaternion<f64>,
+    /// Antenna phase centre relative to the IMU, body FLU (m), `mounting.antenna_lever_arm_m`
+    /// (default `[0, 0, 0]`).
+    pub lever_arm_b_m: Vector3<f64>,
+}
+
+/// `clock.*`: receiver clock bias c·δt_u (m) and drift c·δt_ru (m/s).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ClockConfig {
+    /// White noise driving the bias (m/√s), `clock.bias_noise_m_per_sqrt_s` (default `0.5`).
+    pub bias_noise_m_per_sqrt_s: f64,
+    /// White noise driving the drift (m/s/√s), `clock.drift_noise_mps_per_sqrt_s` (default `0.1`).
+    pub drift_noise_m_s_per_sqrt_s: f64,
+    /// Drift correlation time (s), `clock.drift_correlation_time_s` (default `1800`).
+    pub drift_time_s: f64,
+}
+
+/// `gnss.*`, in SI.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GnssConfig {
+    /// Satellites below this elevation are not used (rad), `gnss.elevation_mask_deg` (default
+    /// `10`).
+    pub elevation_mask_rad: f64,
+    /// Satellites below this C/N0 are not used (dB-Hz; 0 = off), `gnss.cn0_mask_dbhz` (default
+    /// `0`).
+    pub cn0_mask_dbhz: f64,
+    /// Zenith 1σ of a pseudo-range (m), `gnss.pseudorange_sigma_m` (default `3.0`).
+    pub pseudorange_sigma_m: f64,
+    /// Zenith 1σ of a pseudo-range rate (m/s), `gnss.pseudorange_rate_sigma_mps` (default `0.1`).
+    pub pseudorange_rate_sigma_mps: f64,
+    /// Scale the zenith σ by 1 / sin(elevation), `gnss.elevation_weighting` (default `true`).
+    pub elevation_weighting: bool,
+    /// Use the receiver's own σ when it reports one, `gnss.use_receiver_sigmas` (default `false`).
+    pub use_receiver_sigmas: bool,
+    /// Fuse pseudo-range rates as well as ranges, `gnss.use_pseudorange_rate` (default `true`).
+    pub use_pseudorange_rate: bool,
+    /// Reject a measurement whose |innovation| > gate · √S (0 = off),
+    /// `gnss.innovation_gate_sigma` (default `5.0`).
+    pub innovation_gate_sigma: f64,
+    /// Constellations used, `gnss.constellations` (default `[gps, galileo, beidou]`); non-empty,
+    /// unique.
+    pub constellations: Vec<Constellation>,
+    /// A common pseudo-range step larger than this (m) is absorbed as a receiver clock jump,
+    /// `gnss.clock_jump_threshold_m` (default `100000`).
+    pub max_clock_jump_m: f64,
+}
+
+/// `loose.*`: weighting of the receiver fix in loose coupling.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LooseConfig {
+    /// true = weight the fix by the covariance the receiver publishes with it; false = by
+    /// the σ below. `loose.use_fix_covariance` (default `true`).
+    pub use_fix_covariance: bool,
+    /// Horizontal 1σ of a fix (m), `loose.fix_sigma_horizontal_m` (default `1.5`).
+    pub fix_sigma_horizontal_m: f64,
+    /// Vertical 1σ of a fix (m), `loose.fix_sigma_vertical_m` (default `3.0`).
+    pub fix_sigma_vertical_m: f64,
+    /// 1σ of each receiver velocity component (m/s), `loose.velocity_sigma_mps` (default `0.1`).
+    pub velocity_sigma_mps: f64,
+}
+
+/// `init.*`: start-up and initial 1σ of the state blocks, in SI.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InitConfig {
+    /// Known initial heading (rad), compass convention: the body x axis measured clockwise
+    /// from true north (ENU yaw = π/2 − heading). `init.heading_deg` (default `null` = from
+    /// the GNSS velocity once moving).
+    pub heading_rad: Option<f64>,
+    /// Speed above which the GNSS velocity gives the heading (m/s),
+    /// `init.heading_min_speed_mps` (default `1.0`).
+    pub heading_min_speed_mps: f64,
+    /// Accelerometer averaging for roll and pitch at rest (s), `init.leveling_duration_s` (default
+    /// `1.0`).
+    pub leveling_duration_s: f64,
+    /// Satellites needed for the single-point start (≥ 4), `init.min_satellites` (default `5`).
+    pub min_satellites: usize,
+    /// Initial roll/pitch 1σ (rad), `init.attitude_sigma_deg` (default `1.0`).
+    pub attitude_sigma_rad: f64,
+    /// Initial heading 1σ (rad), `init.heading_sigma_deg` (default `5.0`).
+    pub heading_sigma_rad: f64,
+    /// Initial velocity 1σ per axis (m/s), `init.velocity_sigma_mps` (default `0.5`).
+    pub velocity_sigma_mps: f64,
+    /// Initial position 1σ per axis (m), `init.position_sigma_m` (default `5.0`).
+    pub position_sigma_m: f64,
+    /// Initial clock bias 1σ (m), `init.clock_bias_sigma_m` (default `30.0`).
+    pub clock_bias_sigma_m: f64,
+    /// Initial clock drift 1σ (m/s), `init.clock_drift_sigma_mps` (default `5.0`).
+    pub clock_drift_sigma_mps: f64,
+}
+
+/// `engine.*`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EngineConfig {
+    /// How far back a late GNSS epoch may reach into the IMU history (s),
+    /// `engine.imu_buffer_s` (default `2.0`).
+    pub imu_buffer_s: f64,
+    /// A larger gap between IMU samples is rejected and the filter coasts or re-initialises
+    /// (s), `engine.max_imu_gap_s` (default `1.0`).
+    pub max_imu_gap_s: f64,
+}
+
+/// `output.*`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OutputConfig {
+    /// Origin of the local ENU frame of the odometry, `output.datum_llh_deg_m`
+    /// (default `null` = the first fix), written as `[lat_deg, lon_deg, height_m]`.
+    pub datum: Option<Llh>,
+    /// Output rate (Hz; 0 = every IMU sample), `output.rate_hz` (default `0`).
+    pub rate_hz: f64,
+}

@@ -1,0 +1,150 @@
+//! The raw configuration as a YAML tree (section -> key -> value, human units), the form
+//! that is echoed, listed as ROS parameters and edited by one dotted key.
+
+use serde_yaml::{Mapping, Value};
+
+use super::raw::RawConfig;
+
+impl RawConfig {
+    /// The parameters as a YAML tree, section -> key -> value, in file order. This is the
+    /// inverse of deserialisation (tested), written out so that it cannot fail.
+    pub fn to_tree(&self) -> Mapping {
+        let f = &self.filter;
+        let i = &self.imu;
+        let m = &self.mounting;
+        let c = &self.clock;
+        let g = &self.gnss;
+        let l = &self.loose;
+        let n = &self.init;
+        let e = &self.engine;
+        let o = &self.output;
+        let constellations = g.constellations.iter().map(|c| text(c.as_str())).collect();
+        let sections = [
+            (
+                "filter",
+                vec![
+                    ("variant", text(f.variant.as_str())),
+                    ("coupling", text(f.coupling.as_str())),
+                    ("joseph_form", Value::Bool(f.joseph_form)),
+                ],
+            ),
+            (
+                "imu",
+                vec![
+                    ("gyro_arw_deg_per_sqrt_h", num(i.gyro_arw_deg_per_sqrt_h)),
+                    ("gyro_bias_deg_per_h", num(i.gyro_bias_deg_per_h)),
+                    (
+                        "gyro_markov_sigma_deg_per_h",
+                        num(i.gyro_markov_sigma_deg_per_h),
+                    ),
+                    (
+                        "gyro_markov_correlation_time_s",
+                        num(i.gyro_markov_correlation_time_s),
+                    ),
+                    ("accel_vrw_ug_per_sqrt_hz", num(i.accel_vrw_ug_per_sqrt_hz)),
+                    ("accel_bias_ug", num(i.accel_bias_ug)),
+                    (
+                        "accel_bias_correlation_time_s",
+                        num(i.accel_bias_correlation_time_s),
+                    ),
+                ],
+            ),
+            (
+                "mounting",
+                vec![
+                    ("imu_rotation_rpy_deg", triple(&m.imu_rotation_rpy_deg)),
+                    ("antenna_lever_arm_m", triple(&m.antenna_lever_arm_m)),
+                ],
+            ),
+            (
+                "clock",
+                vec![
+                    ("bias_noise_m_per_sqrt_s", num(c.bias_noise_m_per_sqrt_s)),
+                    (
+                        "drift_noise_mps_per_sqrt_s",
+                        num(c.drift_noise_mps_per_sqrt_s),
+                    ),
+                    ("drift_correlation_time_s", num(c.drift_correlation_time_s)),
+                ],
+            ),
+            (
+                "gnss",
+                vec![
+                    ("elevation_mask_deg", num(g.elevation_mask_deg)),
+                    ("cn0_mask_dbhz", num(g.cn0_mask_dbhz)),
+                    ("pseudorange_sigma_m", num(g.pseudorange_sigma_m)),
+                    (
+                        "pseudorange_rate_sigma_mps",
+                        num(g.pseudorange_rate_sigma_mps),
+                    ),
+                    ("elevation_weighting", Value::Bool(g.elevation_weighting)),
+                    ("use_receiver_sigmas", Value::Bool(g.use_receiver_sigmas)),
+                    ("use_pseudorange_rate", Value::Bool(g.use_pseudorange_rate)),
+                    ("innovation_gate_sigma", num(g.innovation_gate_sigma)),
+                    ("constellations", Value::Sequence(constellations)),
+                    ("clock_jump_threshold_m", num(g.clock_jump_threshold_m)),
+                ],
+            ),
+            (
+                "loose",
+                vec![
+                    ("use_fix_covariance", Value::Bool(l.use_fix_covariance)),
+                    ("fix_sigma_horizontal_m", num(l.fix_sigma_horizontal_m)),
+                    ("fix_sigma_vertical_m", num(l.fix_sigma_vertical_m)),
+                    ("velocity_sigma_mps", num(l.velocity_sigma_mps)),
+                ],
+            ),
+            (
+                "init",
+                vec![
+                    ("heading_deg", n.heading_deg.map_or(Value::Null, num)),
+                    ("heading_min_speed_mps", num(n.heading_min_speed_mps)),
+                    ("leveling_duration_s", num(n.leveling_duration_s)),
+                    ("min_satellites", Value::from(n.min_satellites)),
+                    ("attitude_sigma_deg", num(n.attitude_sigma_deg)),
+                    ("heading_sigma_deg", num(n.heading_sigma_deg)),
+                    ("velocity_sigma_mps", num(n.velocity_sigma_mps)),
+                    ("position_sigma_m", num(n.position_sigma_m)),
+                    ("clock_bias_sigma_m", num(n.clock_bias_sigma_m)),
+                    ("clock_drift_sigma_mps", num(n.clock_drift_sigma_mps)),
+                ],
+            ),
+            (
+                "engine",
+                vec![
+                    ("imu_buffer_s", num(e.imu_buffer_s)),
+                    ("max_imu_gap_s", num(e.max_imu_gap_s)),
+                ],
+            ),
+            (
+                "output",
+                vec![
+                    (
+                        "datum_llh_deg_m",
+                        o.datum_llh_deg_m.as_ref().map_or(Value::Null, triple),
+                    ),
+                    ("rate_hz", num(o.rate_hz)),
+                ],
+            ),
+        ];
+        sections
+            .into_iter()
+            .map(|(section, keys)| {
+                let keys = keys.into_iter().map(|(k, v)| (text(k), v)).collect();
+                (text(section), Value::Mapping(keys))
+            })
+            .collect()
+    }
+}
+
+fn num(x: f64) -> Value {
+    Value::from(x)
+}
+
+fn text(s: &str) -> Value {
+    Value::String(s.to_owned())
+}
+
+fn triple(v: &[f64; 3]) -> Value {
+    Value::Sequence(v.iter().copied().map(num).collect())
+}

@@ -1,0 +1,504 @@
+//! The configuration loader against the preset files in `params/` and against bad input.
+
+use std::path::{Path, PathBuf};
+
+use adaptive_gnss_ins::config::{
+    Config, ConfigError, Coupling, PARAMETER_OVERRIDE_ORIGIN, RAD_PER_DEG, RAD_S_PER_DEG_H,
+};
+use adaptive_gnss_ins::gnss::Constellation;
+use serde_yaml::Value;
+
+fn params_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("params")
+}
+
+fn preset_files() -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(params_dir())
+        .unwrap()
+        .map(|entry| entry.unwrap().path())
+        .filter(|path| path.extension().is_some_and(|ext| ext == "yaml"))
+        .collect();
+    files.sort();
+    files
+}
+
+fn load(name: &str) -> Config {
+    let text = std::fs::read_to_string(params_dir().join(name)).unwrap();
+    Config::from_yaml_str(&text, name).unwrap()
+}
+
+/// A parameter file holding `body` (section lines indented by four spaces).
+fn file(body: &str) -> String {
+    format!("gnss_ins_node:\n  ros__parameters:\n{body}")
+}
+
+fn load_error(body: &str) -> ConfigError {
+    Config::from_yaml_str(&file(body), "test.yaml").unwrap_err()
+}
+
+/// The message names the key and the origin.
+fn assert_names(error: &ConfigError, key: &str, origin: &str) {
+    let message = error.to_string();
+    assert!(
+        message.contains(&format!("`{key}`")),
+        "no key `{key}` in: {message}"
+    );
+    assert!(message.contains(origin), "no origin {origin} in: {message}");
+    assert_eq!(error.key(), Some(key));
+    assert_eq!(error.origin(), origin);
+}
+
+/// Every non-default value of every key, to check that each key is read and echoed.
+const EVERY_KEY_CHANGED: &str = "
+    filter: {variant: ekf, coupling: loose, joseph_form: false}
+    imu:
+      gyro_arw_deg_per_sqrt_h: 0.15
+      gyro_bias_deg_per_h: 3.3
+      gyro_markov_sigma_deg_per_h: 1.7
+      gyro_markov_correlation_time_s: 1000.5
+      accel_vrw_ug_per_sqrt_hz: 57.0
+      accel_bias_ug: 321.0
+      accel_bias_correlation_time_s: 777.0
+    mounting:
+      imu_rotation_rpy_deg: [1.5, -2.25, 179.0]
+      antenna_lever_arm_m: [0.31, -0.12, 1.07]
+    clock:
+      bias_noise_m_per_sqrt_s: 0.7
+      drift_noise_mps_per_sqrt_s: 0.03
+      drift_correlation_time_s: 600.0
+    gnss:
+      elevation_mask_deg: 15.5
+      cn0_mask_dbhz: 32.0
+      pseudorange_sigma_m: 4.2
+      pseudorange_rate_sigma_mps: 0.25
+      elevation_weighting: false
+      use_receiver_sigmas: true
+      use_pseudorange_rate: false
+      innovation_gate_sigma: 0.0
+      constellations: [glonass, qzss, sbas, gps]
+      clock_jump_threshold_m: 5000.0
+    loose:
+      use_fix_covariance: false
+      fix_sigma_horizontal_m: 2.5
+      fix_sigma_vertical_m: 4.5
+      velocity_sigma_mps: 0.3
+    init:
+      heading_deg: -37.3
+      heading_min_speed_mps: 2.0
+      leveling_duration_s: 3.5
+      min_satellites: 6
+      attitude_sigma_deg: 2.0
+      heading_sigma_deg: 20.0
+      velocity_sigma_mps: 0.1
+      position_sigma_m: 2.0
+      clock_bias_sigma_m: 100.0
+      clock_drift_sigma_mps: 1.0
+    engine:
+      imu_buffer_s: 5.0
+      max_imu_gap_s: 0.2
+    output:
+      datum_llh_deg_m: [-33.8688, 151.2093, 58.2]
+      rate_hz: 50.0
+";
+
+#[test]
+fn every_preset_file_parses() {
+    let files = preset_files();
+    assert!(files.len() >= 2, "{files:?}");
+    for path in files {
+        let text = std::fs::read_to_string(&path).unwrap();
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        Config::from_yaml_str(&text, &name).unwrap_or_else(|e| panic!("{e}"));
+    }
+}
+
+#[test]
+fn ekf_preset_is_the_built_in_default() {
+    assert_eq!(load("ekf.yaml"), Config::default());
+}
+
+#[test]
+fn ekf_loose_preset_differs_from_the_default_only_in_coupling() {
+    let mut expected = Config::default();
+    expected.filter.coupling = Coupling::Loose;
+    assert_eq!(load("ekf_loose.yaml"), expected);
+}
+
+/// The manual can't drift: each preset lists every key, each key is preceded by a comment
+/// with its unit and its default, and that stated default is the built-in default.
+#[test]
+fn every_preset_documents_every_key_with_unit_and_true_default() {
+    let defaults = Config::default().parameters();
+    for path in preset_files() {
+        let text = std::fs::read_to_string(&path).unwrap();
+        let mut section = String::new();
+        let mut comment = String::new();
+        let mut documented = Vec::new();
+        for line in text.lines() {
+            let trimmed = line.trim_start();
+            let indent = line.len() - trimmed.len();
+            if let Some(c) = trimmed.strip_prefix('#') {
+                comment.push_str(c);
+                comment.push('\n');
+                continue;
+            }
+            if indent == 4 && trimmed.ends_with(':') {
+                section = trimmed.trim_end_matches(':').to_owned();
+            } else if indent == 6 {
+                let (key, _) = trimmed.split_once(':').unwrap();
+                let dotted = format!("{section}.{key}");
+                assert!(
+                    comment.contains("Unit:"),
+                    "{path:?} {dotted}: no `Unit:` in comment"
+                );
+                let stated = comment
+                    .split_once("Default:")
+                    .unwrap_or_else(|| panic!("{path:?} {dotted}: no `Default:` in comment"))
+                    .1
+                    .trim();
+                let stated: Value = serde_yaml::from_str(stated).unwrap();
+                let (_, default) = defaults.iter().find(|(k, _)| *k == dotted).unwrap();
+                assert_eq!(&stated, default, "{path:?} {dotted}: stated default");
+                documented.push(dotted);
+            }
+            comment.clear();
+        }
+        let all: Vec<&String> = defaults.iter().map(|(k, _)| k).collect();
+        let documented: Vec<&String> = documented.iter().collect();
+        assert_eq!(documented, all, "{path:?}: keys listed");
+    }
+}
+
+#[test]
+fn human_units_are_converted_to_si() {
+    let config = Config::default();
+    // 0.5 deg/h = 0.5 × 4.8481368e-6 rad/s.
+    assert!((config.imu.gyro_bias_sigma_rad_s - 2.424_068_4e-6).abs() < 1e-13);
+    // 0.012 deg/√h = 0.012 × π/180/60 rad/√s = 3.4906585e-6 rad/√s.
+    assert!((config.imu.gyro_arw_rad_per_sqrt_s - 3.490_658_5e-6).abs() < 1e-13);
+    // 100 µg/√Hz = 9.80665e-4 m/s/√s; 1250 µg = 0.0122583 m/s².
+    assert!((config.imu.accel_vrw_m_s_per_sqrt_s - 9.806_65e-4).abs() < 1e-15);
+    assert!((config.imu.accel_bias_sigma_m_s2 - 0.012_258_312_5).abs() < 1e-15);
+    // 10° = 0.17453293 rad.
+    assert!((config.gnss.elevation_mask_rad - 0.174_532_925_2).abs() < 1e-10);
+    assert!((config.init.heading_sigma_rad - 0.087_266_462_6).abs() < 1e-10);
+    assert_eq!(
+        config.gnss.constellations,
+        vec![
+            Constellation::Gps,
+            Constellation::Galileo,
+            Constellation::Beidou
+        ]
+    );
+
+    let one = Config::from_yaml_str(
+        &file(
+            "    imu: {gyro_bias_deg_per_h: 1.0}\n    output: {datum_llh_deg_m: [45.0, -90.0, 12.5]}\n",
+        ),
+        "one.yaml",
+    )
+    .unwrap();
+    // 1 deg/h = 4.8481e-6 rad/s.
+    assert!((one.imu.gyro_bias_sigma_rad_s - 4.848_1e-6).abs() < 1e-10);
+    assert!((one.imu.gyro_bias_sigma_rad_s - RAD_S_PER_DEG_H).abs() < 1e-20);
+    let datum = one.output.datum.unwrap();
+    assert!((datum.lat_rad - std::f64::consts::FRAC_PI_4).abs() < 1e-15);
+    assert!((datum.lon_rad + std::f64::consts::FRAC_PI_2).abs() < 1e-15);
+    assert_eq!(datum.height_m, 12.5);
+}
+
+#[test]
+fn a_partial_file_keeps_every_other_default() {
+    let config = Config::from_yaml_str(
+        "/**:\n  ros__parameters:\n    gnss:\n      pseudorange_sigma_m: 2.0\n    init:\n",
+        "partial.yaml",
+    )
+    .unwrap();
+    let mut expected = Config::default();
+    expected.gnss.pseudorange_sigma_m = 2.0;
+    assert_eq!(config, expected);
+    let empty = Config::from_yaml_str("my_node:\n  ros__parameters:\n", "empty.yaml").unwrap();
+    assert_eq!(empty, Config::default());
+}
+
+#[test]
+fn every_key_is_read_and_echoed_back_exactly() {
+    let config = Config::from_yaml_str(&file(EVERY_KEY_CHANGED), "all.yaml").unwrap();
+    let changed = config.parameters();
+    let defaults = Config::default().parameters();
+    assert_eq!(changed.len(), defaults.len());
+    for ((key, value), (default_key, default)) in changed.iter().zip(&defaults) {
+        assert_eq!(key, default_key);
+        if key != "filter.variant" {
+            assert_ne!(value, default, "{key} was not read");
+        }
+    }
+    assert!((config.init.heading_rad.unwrap() + 37.3 * RAD_PER_DEG).abs() < 1e-15);
+
+    let echo = config.to_human_yaml();
+    assert!(
+        echo.contains("imu_rotation_rpy_deg: [1.5, -2.25, 179.0]\n"),
+        "{echo}"
+    );
+    assert_eq!(
+        Config::from_yaml_str(&echo, "echo").unwrap(),
+        config,
+        "echo:\n{echo}"
+    );
+}
+
+#[test]
+fn a_rotation_with_many_decimals_echoes_to_within_rounding() {
+    let body = "    mounting:\n      imu_rotation_rpy_deg: [0.333333333333333333, 89.9, -179.123456789012345]\n";
+    let config = Config::from_yaml_str(&file(body), "rot.yaml").unwrap();
+    let reparsed = Config::from_yaml_str(&config.to_human_yaml(), "echo").unwrap();
+    let angle = reparsed
+        .mounting
+        .imu_to_body
+        .angle_to(&config.mounting.imu_to_body);
+    assert!(angle < 1e-12, "rotation echo off by {angle} rad");
+    let mut aligned = reparsed;
+    aligned.mounting.imu_to_body = config.mounting.imu_to_body;
+    assert_eq!(aligned, config);
+}
+
+#[test]
+fn the_echo_of_each_preset_parses_back_to_an_equal_config() {
+    for name in ["ekf.yaml", "ekf_loose.yaml"] {
+        let config = load(name);
+        let echo = config.to_human_yaml();
+        assert_eq!(
+            Config::from_yaml_str(&echo, "echo").unwrap(),
+            config,
+            "{echo}"
+        );
+    }
+    let echo = Config::default().to_human_yaml();
+    assert!(echo.contains("/**:\n  ros__parameters:\n    filter:\n      variant: ekf\n"));
+    assert!(echo.contains("      gyro_bias_deg_per_h: 0.5\n"), "{echo}");
+    assert!(
+        echo.contains("      constellations: [gps, galileo, beidou]\n"),
+        "{echo}"
+    );
+    assert!(echo.contains("      heading_deg: null\n"), "{echo}");
+}
+
+#[test]
+fn unknown_keys_are_refused_with_their_full_name() {
+    let e = load_error("    imu:\n      gyro_bias_deg_per_hr: 0.5\n");
+    assert!(matches!(e, ConfigError::UnknownKey { .. }), "{e:?}");
+    assert_names(&e, "imu.gyro_bias_deg_per_hr", "test.yaml");
+    assert!(
+        e.to_string().contains("gyro_bias_deg_per_h"),
+        "known keys listed: {e}"
+    );
+
+    let e = load_error("    imus:\n      gyro_bias_deg_per_h: 0.5\n");
+    assert!(matches!(e, ConfigError::UnknownKey { .. }), "{e:?}");
+    assert_names(&e, "imus", "test.yaml");
+}
+
+#[test]
+fn wrong_types_are_refused_with_their_full_name() {
+    let cases = [
+        (
+            "    imu:\n      gyro_bias_deg_per_h: fast\n",
+            "imu.gyro_bias_deg_per_h",
+        ),
+        ("    filter:\n      joseph_form: 1\n", "filter.joseph_form"),
+        ("    filter:\n      variant: ukf\n", "filter.variant"),
+        (
+            "    init:\n      min_satellites: 5.5\n",
+            "init.min_satellites",
+        ),
+        (
+            "    mounting:\n      antenna_lever_arm_m: [0.1, 0.2]\n",
+            "mounting.antenna_lever_arm_m",
+        ),
+        (
+            "    gnss:\n      constellations: [gps, compass]\n",
+            "gnss.constellations[1]",
+        ),
+        ("    engine: 3\n", "engine"),
+    ];
+    for (body, key) in cases {
+        let e = load_error(body);
+        assert!(matches!(e, ConfigError::WrongType { .. }), "{body}: {e:?}");
+        assert_names(&e, key, "test.yaml");
+    }
+}
+
+#[test]
+fn out_of_range_values_are_refused_with_their_full_name() {
+    let cases = [
+        (
+            "    imu:\n      gyro_bias_deg_per_h: -0.5\n",
+            "imu.gyro_bias_deg_per_h",
+        ),
+        (
+            "    gnss:\n      pseudorange_sigma_m: 0.0\n",
+            "gnss.pseudorange_sigma_m",
+        ),
+        (
+            "    imu:\n      accel_bias_correlation_time_s: 0\n",
+            "imu.accel_bias_correlation_time_s",
+        ),
+        (
+            "    clock:\n      drift_correlation_time_s: 0.0\n",
+            "clock.drift_correlation_time_s",
+        ),
+        (
+            "    engine:\n      imu_buffer_s: 0.0\n",
+            "engine.imu_buffer_s",
+        ),
+        (
+            "    init:\n      leveling_duration_s: .nan\n",
+            "init.leveling_duration_s",
+        ),
+        (
+            "    loose:\n      velocity_sigma_mps: .inf\n",
+            "loose.velocity_sigma_mps",
+        ),
+        (
+            "    init:\n      min_satellites: 3\n",
+            "init.min_satellites",
+        ),
+        (
+            "    gnss:\n      elevation_mask_deg: 90.0\n",
+            "gnss.elevation_mask_deg",
+        ),
+        (
+            "    gnss:\n      cn0_mask_dbhz: -1.0\n",
+            "gnss.cn0_mask_dbhz",
+        ),
+        (
+            "    gnss:\n      innovation_gate_sigma: 0.5\n",
+            "gnss.innovation_gate_sigma",
+        ),
+        (
+            "    gnss:\n      constellations: []\n",
+            "gnss.constellations",
+        ),
+        (
+            "    gnss:\n      constellations: [gps, gps]\n",
+            "gnss.constellations",
+        ),
+        (
+            "    output:\n      datum_llh_deg_m: [91.0, 0.0, 0.0]\n",
+            "output.datum_llh_deg_m",
+        ),
+        ("    output:\n      rate_hz: -1.0\n", "output.rate_hz"),
+        (
+            "    mounting:\n      imu_rotation_rpy_deg: [0.0, 95.0, 0.0]\n",
+            "mounting.imu_rotation_rpy_deg",
+        ),
+        (
+            "    mounting:\n      antenna_lever_arm_m: [120.0, 0.0, 0.0]\n",
+            "mounting.antenna_lever_arm_m",
+        ),
+        (
+            "    init:\n      heading_sigma_deg: 400.0\n",
+            "init.heading_sigma_deg",
+        ),
+    ];
+    for (body, key) in cases {
+        let e = load_error(body);
+        assert!(matches!(e, ConfigError::Invalid { .. }), "{body}: {e:?}");
+        assert_names(&e, key, "test.yaml");
+    }
+    let e = load_error("    imu:\n      gyro_bias_deg_per_h: -0.5\n");
+    assert_eq!(
+        e.to_string(),
+        "test.yaml: parameter `imu.gyro_bias_deg_per_h` = -0.5: must be finite and > 0"
+    );
+}
+
+#[test]
+fn a_file_without_the_ros_layout_says_what_is_expected() {
+    let bad = [
+        "imu:\n  gyro_bias_deg_per_h: 0.5\n",
+        "gnss_ins_node:\n  imu:\n    gyro_bias_deg_per_h: 0.5\n",
+        "a:\n  ros__parameters: {}\nb:\n  ros__parameters: {}\n",
+        "gnss_ins_node:\n  ros__parameters: 3\n",
+        "",
+        "- 1\n- 2\n",
+    ];
+    for text in bad {
+        let e = Config::from_yaml_str(text, "layout.yaml").unwrap_err();
+        assert!(matches!(e, ConfigError::Layout { .. }), "{text}: {e:?}");
+        let message = e.to_string();
+        assert!(message.starts_with("layout.yaml: "), "{message}");
+        assert!(message.contains("ros__parameters"), "{message}");
+    }
+}
+
+#[test]
+fn yaml_syntax_errors_carry_line_and_column() {
+    let text = file("    imu:\n      gyro_bias_deg_per_h: [0.5\n    gnss: {}\n");
+    let e = Config::from_yaml_str(&text, "syntax.yaml").unwrap_err();
+    match &e {
+        ConfigError::Yaml { origin, line, .. } => {
+            assert_eq!(origin, "syntax.yaml");
+            assert!(line.is_some_and(|l| l >= 4), "{e}");
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(e.to_string().contains(" at line "), "{e}");
+
+    let duplicate = file("    imu:\n      accel_bias_ug: 1.0\n      accel_bias_ug: 2.0\n");
+    let e = Config::from_yaml_str(&duplicate, "dup.yaml").unwrap_err();
+    // The parser points at the start of the mapping that holds the duplicate (line 4).
+    assert!(
+        matches!(e, ConfigError::Yaml { line: Some(4), .. }),
+        "{e:?}"
+    );
+    assert!(e.to_string().contains("accel_bias_ug"), "{e}");
+}
+
+#[test]
+fn set_parameter_applies_and_validates() {
+    let mut config = Config::default();
+    config
+        .set_parameter("imu.gyro_bias_deg_per_h", "0.3")
+        .unwrap();
+    assert_eq!(config.imu.gyro_bias_sigma_rad_s, 0.3 * RAD_S_PER_DEG_H);
+    config.set_parameter("filter.coupling", "loose").unwrap();
+    config.set_parameter("init.heading_deg", "90").unwrap();
+    assert_eq!(config.filter.coupling, Coupling::Loose);
+    assert!((config.init.heading_rad.unwrap() - std::f64::consts::FRAC_PI_2).abs() < 1e-15);
+    let listed = config.parameters();
+    let value = |key: &str| listed.iter().find(|(k, _)| k == key).unwrap().1.clone();
+    assert_eq!(value("imu.gyro_bias_deg_per_h"), Value::from(0.3));
+    assert_eq!(value("filter.coupling"), Value::from("loose"));
+    assert_eq!(value("init.heading_deg"), Value::from(90.0));
+
+    let mut expected = Config::default();
+    expected.imu.gyro_bias_sigma_rad_s = 0.3 * RAD_S_PER_DEG_H;
+    expected.filter.coupling = Coupling::Loose;
+    expected.init.heading_rad = Some(90.0 * RAD_PER_DEG);
+    assert_eq!(config, expected);
+
+    let before = config.clone();
+    let cases = [
+        ("imu.gyro_bias_deg_per_h", "-1", "imu.gyro_bias_deg_per_h"),
+        ("imu.gyro_bias_deg_per_h", "abc", "imu.gyro_bias_deg_per_h"),
+        ("imu.gyro_bias_deg_per_hr", "1", "imu.gyro_bias_deg_per_hr"),
+        ("imu", "1", "imu"),
+        (
+            "inertial.gyro_bias_deg_per_h",
+            "1",
+            "inertial.gyro_bias_deg_per_h",
+        ),
+        ("init.min_satellites", "2", "init.min_satellites"),
+    ];
+    for (key, value, named) in cases {
+        let e = config.set_parameter(key, value).unwrap_err();
+        assert_names(&e, named, PARAMETER_OVERRIDE_ORIGIN);
+        assert_eq!(config, before, "{key} = {value} changed the configuration");
+    }
+    let e = config
+        .set_parameter("imu.gyro_bias_deg_per_h", "[1,")
+        .unwrap_err();
+    assert!(matches!(e, ConfigError::Yaml { .. }), "{e:?}");
+    assert_eq!(config, before);
+}
