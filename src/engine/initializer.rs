@@ -6,7 +6,7 @@
 //! 2. Until the filter starts, the attitude is carried forward by the gyros alone.
 //! 3. Position, velocity and clock come from an iterated least-squares single-point
 //!    solution (tightly coupled) or the receiver's fix (loosely coupled).
-//! 4. The heading is `init.heading_deg` when given; otherwise the direction of the GNSS
+//! 4. The heading is `init.heading_deg` (a compass heading) when given; otherwise the direction of the GNSS
 //!    velocity once the speed exceeds `init.heading_min_speed_mps`, assuming the body's
 //!    forward axis points along the motion (vehicles, walking with the device ahead).
 
@@ -129,7 +129,7 @@ impl Initializer {
             // pitch = atan2(−f_x, √(f_y² + f_z²)) (FLU body, REP-103 angles).
             let roll = f[1].atan2(f[2]);
             let pitch = (-f[0]).atan2(f[1].hypot(f[2]));
-            let yaw = config.init.heading_rad.unwrap_or(0.0);
+            let yaw = config.init.heading_rad.map_or(0.0, enu_yaw_of_heading);
             let q_nb = UnitQuaternion::from_euler_angles(roll, pitch, yaw);
             self.attitude = Some(Attitude {
                 q_nb,
@@ -214,8 +214,8 @@ impl Initializer {
 
     /// Heading (ENU yaw, rad) and whether it came from motion; None while unknown.
     fn heading(&self, v_enu: Option<&Vector3<f64>>, config: &Config) -> Option<(f64, bool)> {
-        if let Some(yaw) = config.init.heading_rad {
-            return Some((yaw, false));
+        if let Some(heading) = config.init.heading_rad {
+            return Some((enu_yaw_of_heading(heading), false));
         }
         let v = v_enu?;
         (v[0].hypot(v[1]) >= config.init.heading_min_speed_mps).then(|| (v[1].atan2(v[0]), true))
@@ -301,6 +301,11 @@ fn filter_constellations(epoch: &GnssEpoch, config: &Config) -> GnssEpoch {
             .collect(),
         ..epoch.clone()
     }
+}
+
+/// ENU yaw (from East towards North) of a compass heading (from North towards East).
+fn enu_yaw_of_heading(heading_rad: f64) -> f64 {
+    std::f64::consts::FRAC_PI_2 - heading_rad
 }
 
 /// The same roll and pitch with a new yaw (ENU, from East towards North).

@@ -86,9 +86,10 @@ impl StaticScenario {
     }
 }
 
-/// The default configuration with the heading given (a static receiver cannot find it).
+/// The default configuration with the heading given (a static receiver cannot find it)
+/// for the ENU yaw `yaw_rad`.
 pub fn static_config(yaw_rad: f64) -> Config {
     let mut config = Config::default();
-    config.init.heading_rad = Some(yaw_rad);
+    config.init.heading_rad = Some(std::f64::consts::FRAC_PI_2 - yaw_rad);
     config
 }
