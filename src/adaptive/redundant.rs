@@ -6,8 +6,8 @@
 //! - Gaussian regime: R̂ = E[∇Z²]/2 (eqs. 17–18), the expectation a window mean over the
 //!   last M samples, or its random-weighted form (eq. 19) when enabled;
 //! - non-Gaussian regime (entered by the KDE credibility test of section 3.2): the window's
-//!   variance corrected by a Burg AR model whose order Akaike's criterion picks (eqs.
-//!   25–29), halved: R̂ = σ²_∇Z/2.
+//!   variance corrected by a Burg AR model whose order Akaike's criterion (or, as an
+//!   option, Schwarz's) picks (eqs. 25–29), halved: R̂ = σ²_∇Z/2.
 //!
 //! Math note (the factor 1/2, eq. 17): for white GNSS noise V of variance R and negligible
 //! INS noise, ∇Z(k) ≈ V(k) − V(k−1) has variance 2R. The same reasoning is applied to the
@@ -23,7 +23,7 @@
 use std::collections::VecDeque;
 
 use super::ar_variance::{ar_corrected_variance, mean_square};
-use super::burg::select_order_aic;
+use super::burg::{select_order, OrderCriterion};
 use super::error::{check_finite, AdaptiveError};
 use super::kde::{credibility, Credibility};
 use super::random_weighting::{random_weighted_second_moment, DirichletWeights};
@@ -47,8 +47,10 @@ pub struct RedundantNoiseOptions {
     /// Consecutive non-credible samples that switch to the non-Gaussian regime, and
     /// consecutive credible samples that switch back. Default 3.
     pub kde_consecutive_epochs: usize,
-    /// Highest AR order tried by Akaike's criterion in the non-Gaussian regime. Default 5.
+    /// Highest AR order tried in the non-Gaussian regime. Default 5.
     pub ar_max_order: usize,
+    /// Criterion choosing the AR order. Default Akaike's, as in the paper.
+    pub ar_order_criterion: OrderCriterion,
     /// Floor of the eq. (29) denominator 1 − Σ a_i β_i, in (0, 1]: caps the AR inflation of
     /// the variance at 1/floor. Default 0.1 (at most ten times the window mean square).
     pub ar_denominator_floor: f64,
@@ -65,6 +67,7 @@ impl Default for RedundantNoiseOptions {
             kde_threshold: 3.0,
             kde_consecutive_epochs: 3,
             ar_max_order: 5,
+            ar_order_criterion: OrderCriterion::Aic,
             ar_denominator_floor: 0.1,
             seed: 0,
         }
@@ -132,9 +135,9 @@ pub enum VarianceMethod {
     Rmae,
     /// Random-weighted second moment halved, eqs. (17), (19).
     RandomWeightedRmae,
-    /// Eq. (29) variance halved, with the AR order chosen by AIC.
+    /// Eq. (29) variance halved, with the AR order chosen by the configured criterion.
     BurgAr {
-        /// AR order p chosen by Akaike's criterion (0 means no correlation found).
+        /// AR order p chosen by the criterion (0 means no correlation found).
         order: usize,
         /// 1 − Σ a_i β_i as computed.
         raw_denominator: f64,
@@ -314,7 +317,11 @@ impl RedundantNoiseEstimator {
                 Ok((moment / 2.0, VarianceMethod::RandomWeightedRmae))
             }
             NoiseRegime::Gaussian => Ok((mean_square(window)? / 2.0, VarianceMethod::Rmae)),
-            NoiseRegime::NonGaussian => match select_order_aic(window, self.options.ar_max_order) {
+            NoiseRegime::NonGaussian => match select_order(
+                window,
+                self.options.ar_max_order,
+                self.options.ar_order_criterion,
+            ) {
                 Ok(model) => {
                     let corrected = ar_corrected_variance(
                         window,
