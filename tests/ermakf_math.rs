@@ -4,9 +4,12 @@
 
 use adaptive_gnss_ins::adaptive::ar_variance::ar_corrected_variance;
 use adaptive_gnss_ins::adaptive::burg::{burg, select_order, select_order_aic, OrderCriterion};
+use adaptive_gnss_ins::adaptive::innovation::{
+    InnovationCovarianceEstimator, InnovationOptions, InnovationOutcome,
+};
 use adaptive_gnss_ins::adaptive::kde::{kde_density, silverman_bandwidth};
 use adaptive_gnss_ins::adaptive::redundant::{
-    NoiseRegime, RedundantEstimate, RedundantNoiseEstimator, RedundantNoiseOptions,
+    NoiseRegime, RedundantEstimate, RedundantNoiseEstimator, RedundantNoiseOptions, VarianceMethod,
 };
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -489,4 +492,67 @@ fn kde_detector_flags_heavy_tails_and_clears() {
         "clearing latencies {:?}",
         hist(&clear_latency)
     );
+}
+
+/// In the non-Gaussian regime the estimate is the eq. (29) variance of the window, halved,
+/// with the order of the configured criterion: recomputed here from the same window.
+#[test]
+fn non_gaussian_estimate_is_half_the_eq29_variance() {
+    let options = RedundantNoiseOptions::default();
+    let m = options.window_size_m;
+    let mut rng = ChaCha8Rng::seed_from_u64(77);
+    let mut x = white(&mut rng, 1.0, 200);
+    // A sustained multipath-like disturbance: a correlated AR(1) excursion of scale 20.
+    x.extend(ar_sequence(&mut rng, &[0.9], 30).iter().map(|v| 20.0 * v));
+    let mut est = RedundantNoiseEstimator::new(options.clone()).unwrap();
+    let mut last = None;
+    for z in &x {
+        last = Some(est.push(*z).unwrap());
+    }
+    let Some(RedundantEstimate::Ready(e)) = last else {
+        panic!("no estimate")
+    };
+    assert_eq!(e.regime, NoiseRegime::NonGaussian);
+    let window = &x[x.len() - m..];
+    let model = select_order_aic(window, options.ar_max_order).unwrap();
+    let corrected =
+        ar_corrected_variance(window, &model.coefficients, options.ar_denominator_floor).unwrap();
+    match e.method {
+        VarianceMethod::BurgAr { order, .. } => assert_eq!(order, model.order()),
+        other => panic!("expected the Burg AR method, got {other:?}"),
+    }
+    assert!((e.r_variance - corrected.variance / 2.0).abs() <= 1e-12 * corrected.variance);
+}
+
+/// The lag-1 whiteness test of the innovation estimator: size on white innovations close
+/// to its nominal 5 %, power on AR(1) innovations.
+#[test]
+fn innovation_whiteness_test_size_and_power() {
+    let options = InnovationOptions::default();
+    let n = options.window_size;
+    let windows = 400;
+    let rejection_rate = |x: &[f64]| {
+        let mut est = InnovationCovarianceEstimator::new(options.clone()).unwrap();
+        let mut rejected = 0;
+        for (k, v) in x.iter().enumerate() {
+            let out = est.push(*v, 0.0).unwrap();
+            if (k + 1) % n == 0 {
+                if let InnovationOutcome::Ready(e) = out {
+                    rejected += usize::from(e.correlated);
+                }
+            }
+        }
+        rejected as f64 / windows as f64
+    };
+    let mut rng = ChaCha8Rng::seed_from_u64(21);
+    let size = rejection_rate(&white(&mut rng, 2.0, n * windows));
+    let power = rejection_rate(&ar_sequence(&mut rng, &[0.6], n * windows));
+    println!(
+        "lag-1 z-test, N = {n}, α = 5 %: size {:.1} %, power on AR(1) 0.6 {:.1} %",
+        100.0 * size,
+        100.0 * power
+    );
+    // Binomial 3σ band around the nominal 5 % for 400 windows.
+    assert!((0.017..=0.083).contains(&size), "size {size}");
+    assert!(power >= 0.95, "power {power}");
 }

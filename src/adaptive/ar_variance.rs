@@ -1,5 +1,5 @@
 //! Variance of a correlated sequence corrected by its AR model, ERMAKF paper eq. (29)
-//! (after Ghaleb et al., the paper's reference [24]):
+//! (after Ghaleb et al., the paper's reference \[24\]):
 //!
 //! σ² = ((1/M) Σ_{m=0}^{M−1} x_{k−m}²) / (1 − Σ_{i=1}^{p} a_i β_i),
 //!

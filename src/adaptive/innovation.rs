@@ -1,6 +1,6 @@
 //! Windowed innovation-based estimate of the measurement noise variance with a randomness
 //! test and an AR(1) correction: the EIAKF baseline of the ERMAKF paper (its reference
-//! [24], Ghaleb et al.), for one scalar observable.
+//! \[24\], Ghaleb et al.), for one scalar observable.
 //!
 //! Per epoch the caller passes the innovation ν = z − h(x̂⁻) and the scalar H P⁻ Hᵀ of the
 //! same row. Over the last N innovations:
