@@ -1,0 +1,312 @@
+//! Windowed innovation-based estimate of the measurement noise variance with a randomness
+//! test and an AR(1) correction: the EIAKF baseline of the ERMAKF paper (its reference
+//! \[24\], Ghaleb et al.), for one scalar observable.
+//!
+//! Per epoch the caller passes the innovation ν = z − h(x̂⁻) and the scalar H P⁻ Hᵀ of the
+//! same row. Over the last N innovations:
+//! - Ĉ = (1/N) Σ ν² (innovation covariance);
+//! - randomness test: lag-1 autocorrelation r₁ = Σ ν_n ν_{n−1} / Σ ν_n², statistic
+//!   z = √N · r₁, which is N(0, 1) for a white sequence (Bartlett); the sequence is declared
+//!   correlated when |z| exceeds the two-sided normal quantile at `significance`;
+//! - if correlated, AR(1) by Yule–Walker (a = r₁) and the eq. (29) correction with p = 1:
+//!   Ĉ ← Ĉ / (1 − a r₁) = Ĉ / (1 − r₁²), an inflation;
+//! - R̂ = Ĉ − H P⁻ Hᵀ, floored (see [`InnovationOptions`]).
+//!
+//! Choice (test): the lag-1 z-test, because the correction it gates is an AR(1) model; a
+//! Ljung–Box test over more lags would flag correlations that AR(1) does not model.
+//! Innovations are not demeaned: under the null hypothesis of an optimal filter they are
+//! zero-mean and white, and a bias is itself a sign of a mis-modelled filter.
+
+use std::collections::VecDeque;
+
+use statrs::distribution::{ContinuousCDF, Normal};
+
+use super::ar_variance::{ar_corrected_variance, autocorrelation_coefficients, mean_square};
+use super::error::{check_finite, AdaptiveError};
+
+/// Options of one [`InnovationCovarianceEstimator`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct InnovationOptions {
+    /// Window length N (epochs). Default 50.
+    pub window_size: usize,
+    /// Innovations needed before the first estimate (epochs); at least 3, at most
+    /// `window_size`. Default 20.
+    pub min_samples: usize,
+    /// Two-sided significance level α of the lag-1 whiteness test, in (0, 1). Default 0.05.
+    pub significance: f64,
+    /// Absolute floor of R̂ (unit of ν, squared). Default 0, i.e. only the relative floor.
+    pub min_variance: f64,
+    /// Relative floor of R̂ as a fraction of the (corrected) innovation variance Ĉ, in
+    /// (0, 1]. Default 0.1.
+    pub min_fraction_of_innovation: f64,
+    /// Floor of the AR(1) correction denominator 1 − r₁², in (0, 1]. Default 0.1.
+    pub ar_denominator_floor: f64,
+}
+
+impl Default for InnovationOptions {
+    fn default() -> Self {
+        Self {
+            window_size: 50,
+            min_samples: 20,
+            significance: 0.05,
+            min_variance: 0.0,
+            min_fraction_of_innovation: 0.1,
+            ar_denominator_floor: 0.1,
+        }
+    }
+}
+
+impl InnovationOptions {
+    /// Checks the ranges documented on each field.
+    pub fn validate(&self) -> Result<(), AdaptiveError> {
+        let invalid = |name, value: f64, reason| {
+            Err(AdaptiveError::InvalidParameter {
+                name,
+                value,
+                reason,
+            })
+        };
+        if self.min_samples < 3 {
+            return invalid("min_samples", self.min_samples as f64, "must be at least 3");
+        }
+        if self.window_size < self.min_samples {
+            return invalid(
+                "window_size",
+                self.window_size as f64,
+                "must be at least min_samples",
+            );
+        }
+        if !(self.significance > 0.0 && self.significance < 1.0) {
+            return invalid("significance", self.significance, "must lie in (0, 1)");
+        }
+        if !(self.min_variance >= 0.0 && self.min_variance.is_finite()) {
+            return invalid(
+                "min_variance",
+                self.min_variance,
+                "must be non-negative and finite",
+            );
+        }
+        if !(self.min_fraction_of_innovation > 0.0 && self.min_fraction_of_innovation <= 1.0) {
+            return invalid(
+                "min_fraction_of_innovation",
+                self.min_fraction_of_innovation,
+                "must lie in (0, 1]",
+            );
+        }
+        if !(self.ar_denominator_floor > 0.0 && self.ar_denominator_floor <= 1.0) {
+            return invalid(
+                "ar_denominator_floor",
+                self.ar_denominator_floor,
+                "must lie in (0, 1]",
+            );
+        }
+        Ok(())
+    }
+}
+
+/// The estimate after one innovation, once the window holds enough data.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct InnovationEstimate {
+    /// Innovations in the window (the newest included).
+    pub n_samples: usize,
+    /// Ĉ = (1/N) Σ ν², before any correction.
+    pub innovation_variance: f64,
+    /// Lag-1 autocorrelation r₁ of the window (0 for an all-zero window).
+    pub lag1_autocorrelation: f64,
+    /// Test statistic √N · r₁.
+    pub z_statistic: f64,
+    /// True when |z| exceeded the critical value: the AR(1) correction was applied.
+    pub correlated: bool,
+    /// Ĉ after the AR(1) correction (equal to `innovation_variance` when not correlated).
+    pub corrected_innovation_variance: f64,
+    /// R̂ = corrected Ĉ − H P⁻ Hᵀ, after the floors.
+    pub r_variance: f64,
+    /// True when a floor set `r_variance`.
+    pub floored: bool,
+}
+
+/// Outcome of [`InnovationCovarianceEstimator::push`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum InnovationOutcome {
+    /// Fewer than `min_samples` innovations in the window: no estimate.
+    NotEnoughData {
+        /// Innovations in the window now.
+        n_samples: usize,
+        /// Innovations needed.
+        min_samples: usize,
+    },
+    /// An estimate to use.
+    Ready(InnovationEstimate),
+}
+
+/// Windowed innovation-covariance estimator of one scalar observable.
+#[derive(Debug, Clone)]
+pub struct InnovationCovarianceEstimator {
+    options: InnovationOptions,
+    critical_z: f64,
+    window: VecDeque<f64>,
+}
+
+impl InnovationCovarianceEstimator {
+    /// A new estimator with an empty window.
+    pub fn new(options: InnovationOptions) -> Result<Self, AdaptiveError> {
+        options.validate()?;
+        let standard_normal = Normal::standard();
+        let critical_z = standard_normal.inverse_cdf(1.0 - options.significance / 2.0);
+        Ok(Self {
+            window: VecDeque::with_capacity(options.window_size),
+            critical_z,
+            options,
+        })
+    }
+
+    /// Two-sided critical value of |√N r₁| at the configured significance.
+    pub fn critical_z(&self) -> f64 {
+        self.critical_z
+    }
+
+    /// Innovations in the window.
+    pub fn n_samples(&self) -> usize {
+        self.window.len()
+    }
+
+    /// Empties the window (after a gap or a filter re-initialisation).
+    pub fn reset(&mut self) {
+        self.window.clear();
+    }
+
+    /// Adds innovation `innovation` and the scalar `hph` = H P⁻ Hᵀ of the same row, and
+    /// returns the estimate.
+    ///
+    /// Choice (floor): R̂ = max(Ĉ − H P⁻ Hᵀ, `min_fraction_of_innovation`·Ĉ,
+    /// `min_variance`) with Ĉ the corrected innovation variance. A difference at or below
+    /// zero means the predicted covariance already explains the innovations; a fraction of
+    /// Ĉ keeps R̂ positive and on the scale of the data whatever the observable's unit.
+    ///
+    /// Errors: non-finite input or a negative `hph` (the estimator is left unchanged).
+    pub fn push(&mut self, innovation: f64, hph: f64) -> Result<InnovationOutcome, AdaptiveError> {
+        check_finite("innovation estimator input", &[innovation, hph])?;
+        if hph < 0.0 {
+            return Err(AdaptiveError::InvalidParameter {
+                name: "hph",
+                value: hph,
+                reason: "H P Hᵀ must be non-negative",
+            });
+        }
+        if self.window.len() == self.options.window_size {
+            self.window.pop_front();
+        }
+        self.window.push_back(innovation);
+        let n = self.window.len();
+        if n < self.options.min_samples {
+            return Ok(InnovationOutcome::NotEnoughData {
+                n_samples: n,
+                min_samples: self.options.min_samples,
+            });
+        }
+
+        let window = self.window.make_contiguous();
+        let innovation_variance = mean_square(window)?;
+        let r1 = match autocorrelation_coefficients(window, 1) {
+            Ok(beta) => beta.first().copied().unwrap_or(0.0),
+            // An all-zero window: no correlation to speak of.
+            Err(AdaptiveError::ZeroVariance { .. }) => 0.0,
+            Err(e) => return Err(e),
+        };
+        let z_statistic = (n as f64).sqrt() * r1;
+        let correlated = z_statistic.abs() > self.critical_z;
+        let corrected_innovation_variance = if correlated {
+            // Yule–Walker AR(1): a = r₁; eq. (29) with p = 1.
+            ar_corrected_variance(window, &[r1], self.options.ar_denominator_floor)?.variance
+        } else {
+            innovation_variance
+        };
+
+        let difference = corrected_innovation_variance - hph;
+        let floor = (self.options.min_fraction_of_innovation * corrected_innovation_variance)
+            .max(self.options.min_variance);
+        let floored = difference < floor;
+        Ok(InnovationOutcome::Ready(InnovationEstimate {
+            n_samples: n,
+            innovation_variance,
+            lag1_autocorrelation: r1,
+            z_statistic,
+            correlated,
+            corrected_innovation_variance,
+            r_variance: if floored { floor } else { difference },
+            floored,
+        }))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ready(outcome: InnovationOutcome) -> InnovationEstimate {
+        match outcome {
+            InnovationOutcome::Ready(e) => e,
+            other => panic!("expected an estimate, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn critical_value_at_five_percent() {
+        let est = InnovationCovarianceEstimator::new(InnovationOptions::default()).unwrap();
+        assert!((est.critical_z() - 1.959_963_984_540_054).abs() < 1e-9);
+    }
+
+    #[test]
+    fn alternating_sequence_by_hand() {
+        // ν = ±1 alternating, N = 4: Ĉ = 1, r₁ = −3/4, z = 2·(−3/4) = −1.5: white at 5 %.
+        let opts = InnovationOptions {
+            window_size: 4,
+            min_samples: 4,
+            ..InnovationOptions::default()
+        };
+        let mut est = InnovationCovarianceEstimator::new(opts).unwrap();
+        for v in [1.0, -1.0, 1.0] {
+            assert!(matches!(
+                est.push(v, 0.2).unwrap(),
+                InnovationOutcome::NotEnoughData { .. }
+            ));
+        }
+        let e = ready(est.push(-1.0, 0.2).unwrap());
+        assert!((e.lag1_autocorrelation + 0.75).abs() < 1e-15);
+        assert!((e.z_statistic + 1.5).abs() < 1e-15);
+        assert!(!e.correlated);
+        assert!((e.r_variance - 0.8).abs() < 1e-15);
+        assert!(!e.floored);
+    }
+
+    #[test]
+    fn correlated_window_is_inflated_and_floored() {
+        // A slowly varying window: r₁ near 1, test rejects, AR(1) inflation, and a large
+        // H P Hᵀ forces the relative floor.
+        let opts = InnovationOptions {
+            window_size: 30,
+            min_samples: 30,
+            ..InnovationOptions::default()
+        };
+        let mut est = InnovationCovarianceEstimator::new(opts).unwrap();
+        let mut last = None;
+        for i in 0..30 {
+            last = Some(est.push(1.0 + 0.01 * i as f64, 100.0).unwrap());
+        }
+        let e = ready(last.unwrap());
+        assert!(e.correlated);
+        let r1 = e.lag1_autocorrelation;
+        let expected = e.innovation_variance / (1.0 - r1 * r1).max(0.1);
+        assert!((e.corrected_innovation_variance - expected).abs() < 1e-12 * expected);
+        assert!(e.corrected_innovation_variance > e.innovation_variance);
+        assert!(e.floored);
+        assert!((e.r_variance - 0.1 * e.corrected_innovation_variance).abs() < 1e-15);
+    }
+
+    #[test]
+    fn negative_hph_is_rejected() {
+        let mut est = InnovationCovarianceEstimator::new(InnovationOptions::default()).unwrap();
+        assert!(est.push(1.0, -0.1).is_err());
+        assert_eq!(est.n_samples(), 0);
+    }
+}
