@@ -16,6 +16,9 @@
 //! The core (`earth`, `ins`, `gnss`, `filter`, `engine`, `config`) does no I/O, reads no
 //! clock and knows nothing of ROS; `ros` converts messages and wires the node.
 
+pub mod adaptive;
 pub mod earth;
+pub mod filter;
 pub mod gnss;
 pub mod ins;
+pub mod linalg;
