@@ -168,7 +168,17 @@ pub fn ecef_to_llh(r: &Vector3<f64>) -> Option<Llh> {
 pub fn rot_ecef_to_enu(p: &Llh) -> Matrix3<f64> {
     let (sl, cl) = p.lat_rad.sin_cos();
     let (so, co) = p.lon_rad.sin_cos();
-    Matrix3::new(-so, co, 0.0, -sl * co, -sl * so, cl, cl * co, cl * so, sl)
+    Matrix3::new(
+        -so,
+        co,
+        0.0,
+        -sl * co,
+        -sl * so,
+        cl,
+        cl * co,
+        cl * so,
+        sl,
+    )
 }
 
 /// ECEF point to ENU coordinates (m) relative to the datum `origin`.
@@ -232,10 +242,7 @@ mod tests {
         assert!((c * c.transpose() - Matrix3::identity()).norm() < 1e-14);
         let up = c.row(2).transpose();
         let r1 = llh_to_ecef(&p);
-        let r2 = llh_to_ecef(&Llh {
-            height_m: p.height_m + 1.0,
-            ..p
-        });
+        let r2 = llh_to_ecef(&Llh { height_m: p.height_m + 1.0, ..p });
         assert!(((r2 - r1) - up).norm() < 1e-9);
     }
 }
