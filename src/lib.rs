@@ -23,5 +23,6 @@ pub mod engine;
 pub mod filter;
 pub mod gnss;
 pub mod ins;
+pub mod linalg;
 pub mod ros;
 pub mod sim;

@@ -1,6 +1,7 @@
 //! Kalman filter steps and the models they linearize: the error-state process model,
-//! the measurement rows, and the EKF update.
+//! the measurement rows, the EKF update and the cubature rule.
 
+pub mod cubature;
 pub mod ekf;
 pub mod measurement_rows;
 pub mod process_model;
