@@ -3,7 +3,6 @@
 
 use nalgebra::{UnitQuaternion, Vector3};
 
-use crate::filter::ekf;
 use crate::filter::process_model::{self, LinearizationPoint, ProcessNoise};
 use crate::ins::error_state::{
     StateMatrix, StateVector, ACC_BIAS, CLOCK_BIAS, CLOCK_DRIFT, DP, DV, GYRO_BIAS, GYRO_GM, PHI,
@@ -59,8 +58,8 @@ impl FilterState {
             f_ib_b_m_s2: increment.dv_b_m_s / dt,
         };
         let f = process_model::system_matrix(&lin, noise);
-        let (phi, q_d) = process_model::discretize(&f, &process_model::noise_density(noise), dt);
-        self.p = ekf::propagate_covariance(&self.p, &phi, &q_d);
+        let q_c = process_model::noise_density(noise);
+        self.p = process_model::propagate_covariance(&f, &q_c, &self.p, dt);
         self.nav = nav;
         // The nominal Gauss-Markov and clock states follow their expected dynamics.
         self.gyro_markov_rad_s *= (-dt / noise.gyro_markov_time_s).exp();

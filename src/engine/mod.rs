@@ -16,10 +16,10 @@
 
 mod filter_state;
 mod initializer;
-mod loose_update;
+pub mod loose_update;
 mod output;
 mod rejection;
-mod tight_update;
+pub mod tight_update;
 
 use std::collections::VecDeque;
 
@@ -28,7 +28,7 @@ use crate::filter::process_model::ProcessNoise;
 use crate::gnss::GnssEpoch;
 use crate::ins::ImuSample;
 
-pub use filter_state::FilterState;
+pub use filter_state::{interpolate, FilterState};
 pub use initializer::{InitPhase, Initializer};
 pub use loose_update::GnssFix;
 pub use output::{
@@ -36,8 +36,6 @@ pub use output::{
     StatusEvent,
 };
 pub use rejection::{InputRejected, RejectionCounters, RejectionReason};
-
-use filter_state::interpolate;
 
 /// A measurement waiting for its time.
 #[derive(Debug, Clone, PartialEq)]
@@ -450,7 +448,7 @@ impl Engine {
 }
 
 /// The process noise of the configuration.
-fn process_noise(config: &Config) -> ProcessNoise {
+pub fn process_noise(config: &Config) -> ProcessNoise {
     ProcessNoise {
         gyro_arw_rad_per_sqrt_s: config.imu.gyro_arw_rad_per_sqrt_s,
         gyro_markov_sigma_rad_s: config.imu.gyro_markov_sigma_rad_s,

@@ -25,12 +25,6 @@ pub enum FilterError {
     NonFinite,
 }
 
-/// Time update of the covariance, eq. (10): P⁻ = Φ P Φᵀ + Q_d, symmetrized.
-pub fn propagate_covariance(p: &StateMatrix, phi: &StateMatrix, q_d: &StateMatrix) -> StateMatrix {
-    let p_new = phi * p * phi.transpose() + q_d;
-    symmetrize(&p_new)
-}
-
 /// (A + Aᵀ)/2.
 pub fn symmetrize(p: &StateMatrix) -> StateMatrix {
     (p + p.transpose()) * 0.5
