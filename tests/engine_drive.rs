@@ -5,7 +5,7 @@
 //! two-sided 95 % χ² interval on at least 90 % of the epochs.
 
 use adaptive_gnss_ins::config::Config;
-use adaptive_gnss_ins::earth::{self, Llh};
+use adaptive_gnss_ins::earth;
 use adaptive_gnss_ins::engine::{Engine, Output, Solution, StatusEvent};
 use adaptive_gnss_ins::ins::error_state::{DP, DV, PHI};
 use adaptive_gnss_ins::ins::NavState;
