@@ -171,8 +171,9 @@ pub fn bic(n_samples: usize, innovation_variance: f64, order: usize) -> f64 {
     n * innovation_variance.ln() + order as f64 * n.ln()
 }
 
-/// Criterion for choosing the AR order.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+/// Criterion for choosing the AR order (parameter `adaptive.ar_order_criterion`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum OrderCriterion {
     /// Akaike's criterion [`aic`], as in the ERMAKF paper. Not consistent: it picks a
     /// too-high order with a probability that does not vanish as N grows (about 16 % with
@@ -181,6 +182,16 @@ pub enum OrderCriterion {
     Aic,
     /// Schwarz's criterion [`bic`]: consistent (the right order with probability → 1).
     Bic,
+}
+
+impl OrderCriterion {
+    /// The name used in the parameter file.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Aic => "aic",
+            Self::Bic => "bic",
+        }
+    }
 }
 
 /// Fits Burg AR models of every order p ∈ 0..=`max_order` to `x` (as given, not demeaned)

@@ -56,6 +56,10 @@ pub struct RedundantNoiseOptions {
     pub ar_denominator_floor: f64,
     /// Seed of the random-weighting generator (replays are bit-identical). Default 0.
     pub seed: u64,
+    /// Run the KDE test and switch to the AR-corrected variance in the non-Gaussian regime
+    /// (the enhanced filter). Off, the estimator is the simple RMAE of eqs. (17)–(18) or
+    /// (19) (the paper's SRMAKF). Default true.
+    pub detect_non_gaussian: bool,
 }
 
 impl Default for RedundantNoiseOptions {
@@ -70,6 +74,7 @@ impl Default for RedundantNoiseOptions {
             ar_order_criterion: OrderCriterion::Aic,
             ar_denominator_floor: 0.1,
             seed: 0,
+            detect_non_gaussian: true,
         }
     }
 }
@@ -252,7 +257,11 @@ impl RedundantNoiseEstimator {
     pub fn push(&mut self, nabla_z: f64) -> Result<RedundantEstimate, AdaptiveError> {
         check_finite("redundant noise estimator input", &[nabla_z])?;
         let ready = self.window.len() >= self.options.min_samples;
-        let verdict = if ready { self.judge(nabla_z)? } else { None };
+        let verdict = if ready && self.options.detect_non_gaussian {
+            self.judge(nabla_z)?
+        } else {
+            None
+        };
 
         if self.window.len() == self.options.window_size_m {
             self.window.pop_front();

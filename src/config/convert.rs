@@ -7,12 +7,12 @@
 use nalgebra::{UnitQuaternion, Vector3};
 
 use super::raw::{
-    RawClock, RawConfig, RawEngine, RawFilter, RawGnss, RawImu, RawInit, RawLoose, RawMounting,
-    RawOutput,
+    RawAdaptive, RawClock, RawConfig, RawEngine, RawFilter, RawGnss, RawImu, RawInit, RawLoose,
+    RawMounting, RawOutput,
 };
 use super::{
-    ClockConfig, Config, EngineConfig, FilterConfig, GnssConfig, ImuConfig, InitConfig,
-    LooseConfig, MountingConfig, OutputConfig,
+    AdaptiveConfig, ClockConfig, Config, EngineConfig, FilterConfig, GnssConfig, ImuConfig,
+    InitConfig, LooseConfig, MountingConfig, OutputConfig,
 };
 use crate::earth::Llh;
 
@@ -75,6 +75,7 @@ impl From<&RawConfig> for Config {
             clock,
             gnss,
             loose,
+            adaptive,
             init,
             engine,
             output,
@@ -122,6 +123,24 @@ impl From<&RawConfig> for Config {
                 fix_sigma_vertical_m: loose.fix_sigma_vertical_m,
                 velocity_sigma_mps: loose.velocity_sigma_mps,
             },
+            adaptive: AdaptiveConfig {
+                window_size_m: adaptive.window_size_m,
+                min_samples: adaptive.min_samples,
+                random_weighting: adaptive.random_weighting,
+                random_seed: adaptive.random_seed,
+                kde_threshold: adaptive.kde_threshold,
+                kde_consecutive_epochs: adaptive.kde_consecutive_epochs,
+                ar_max_order: adaptive.ar_max_order,
+                ar_order_criterion: adaptive.ar_order_criterion,
+                ar_denominator_floor: adaptive.ar_denominator_floor,
+                innovation_window: adaptive.innovation_window,
+                innovation_significance: adaptive.innovation_significance,
+                pseudorange_sigma_min_m: adaptive.pseudorange_sigma_min_m,
+                pseudorange_sigma_max_m: adaptive.pseudorange_sigma_max_m,
+                pseudorange_rate_sigma_min_mps: adaptive.pseudorange_rate_sigma_min_mps,
+                pseudorange_rate_sigma_max_mps: adaptive.pseudorange_rate_sigma_max_mps,
+                max_epoch_gap_s: adaptive.max_epoch_gap_s,
+            },
             init: InitConfig {
                 heading_rad: init.heading_deg.map(|deg| deg * RAD_PER_DEG),
                 heading_min_speed_mps: init.heading_min_speed_mps,
@@ -158,6 +177,7 @@ impl From<&Config> for RawConfig {
             clock,
             gnss,
             loose,
+            adaptive,
             init,
             engine,
             output,
@@ -210,6 +230,24 @@ impl From<&Config> for RawConfig {
                 fix_sigma_horizontal_m: loose.fix_sigma_horizontal_m,
                 fix_sigma_vertical_m: loose.fix_sigma_vertical_m,
                 velocity_sigma_mps: loose.velocity_sigma_mps,
+            },
+            adaptive: RawAdaptive {
+                window_size_m: adaptive.window_size_m,
+                min_samples: adaptive.min_samples,
+                random_weighting: adaptive.random_weighting,
+                random_seed: adaptive.random_seed,
+                kde_threshold: adaptive.kde_threshold,
+                kde_consecutive_epochs: adaptive.kde_consecutive_epochs,
+                ar_max_order: adaptive.ar_max_order,
+                ar_order_criterion: adaptive.ar_order_criterion,
+                ar_denominator_floor: adaptive.ar_denominator_floor,
+                innovation_window: adaptive.innovation_window,
+                innovation_significance: adaptive.innovation_significance,
+                pseudorange_sigma_min_m: adaptive.pseudorange_sigma_min_m,
+                pseudorange_sigma_max_m: adaptive.pseudorange_sigma_max_m,
+                pseudorange_rate_sigma_min_mps: adaptive.pseudorange_rate_sigma_min_mps,
+                pseudorange_rate_sigma_max_mps: adaptive.pseudorange_rate_sigma_max_mps,
+                max_epoch_gap_s: adaptive.max_epoch_gap_s,
             },
             init: RawInit {
                 heading_deg: init.heading_rad.map(deg),

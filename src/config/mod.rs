@@ -29,12 +29,12 @@ pub use convert::{
 };
 pub use error::ConfigError;
 pub use raw::{
-    ConstellationName, RawClock, RawConfig, RawEngine, RawFilter, RawGnss, RawImu, RawInit,
-    RawLoose, RawMounting, RawOutput,
+    ConstellationName, RawAdaptive, RawClock, RawConfig, RawEngine, RawFilter, RawGnss, RawImu,
+    RawInit, RawLoose, RawMounting, RawOutput,
 };
 pub use sections::{
-    ClockConfig, Config, Coupling, EngineConfig, FilterConfig, FilterVariant, GnssConfig,
-    ImuConfig, InitConfig, LooseConfig, MountingConfig, OutputConfig,
+    AdaptiveConfig, ClockConfig, Config, Coupling, EngineConfig, FilterConfig, FilterVariant,
+    GnssConfig, ImuConfig, InitConfig, LooseConfig, MountingConfig, OutputConfig,
 };
 
 /// The origin quoted in errors from [`Config::set_parameter`].

@@ -6,6 +6,7 @@
 use serde::Deserialize;
 
 use super::{Coupling, FilterVariant};
+use crate::adaptive::burg::OrderCriterion;
 use crate::gnss::Constellation;
 
 /// The whole parameter file below `ros__parameters:`, in human units.
@@ -18,6 +19,7 @@ pub struct RawConfig {
     pub clock: RawClock,
     pub gnss: RawGnss,
     pub loose: RawLoose,
+    pub adaptive: RawAdaptive,
     pub init: RawInit,
     pub engine: RawEngine,
     pub output: RawOutput,
@@ -150,6 +152,51 @@ impl Default for RawLoose {
             fix_sigma_horizontal_m: 1.5,
             fix_sigma_vertical_m: 3.0,
             velocity_sigma_mps: 0.1,
+        }
+    }
+}
+
+/// `adaptive.*`: online measurement-noise estimation (ERMAKF family).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RawAdaptive {
+    pub window_size_m: usize,
+    pub min_samples: usize,
+    pub random_weighting: bool,
+    pub random_seed: u64,
+    pub kde_threshold: f64,
+    pub kde_consecutive_epochs: usize,
+    pub ar_max_order: usize,
+    pub ar_order_criterion: OrderCriterion,
+    pub ar_denominator_floor: f64,
+    pub innovation_window: usize,
+    pub innovation_significance: f64,
+    pub pseudorange_sigma_min_m: f64,
+    pub pseudorange_sigma_max_m: f64,
+    pub pseudorange_rate_sigma_min_mps: f64,
+    pub pseudorange_rate_sigma_max_mps: f64,
+    pub max_epoch_gap_s: f64,
+}
+
+impl Default for RawAdaptive {
+    fn default() -> Self {
+        Self {
+            window_size_m: 100,
+            min_samples: 30,
+            random_weighting: true,
+            random_seed: 0,
+            kde_threshold: 3.0,
+            kde_consecutive_epochs: 3,
+            ar_max_order: 5,
+            ar_order_criterion: OrderCriterion::Aic,
+            ar_denominator_floor: 0.1,
+            innovation_window: 50,
+            innovation_significance: 0.05,
+            pseudorange_sigma_min_m: 0.3,
+            pseudorange_sigma_max_m: 150.0,
+            pseudorange_rate_sigma_min_mps: 0.02,
+            pseudorange_rate_sigma_max_mps: 10.0,
+            max_epoch_gap_s: 2.0,
         }
     }
 }

@@ -16,6 +16,7 @@ pub struct Config {
     pub clock: ClockConfig,
     pub gnss: GnssConfig,
     pub loose: LooseConfig,
+    pub adaptive: AdaptiveConfig,
     pub init: InitConfig,
     pub engine: EngineConfig,
     pub output: OutputConfig,
@@ -29,13 +30,29 @@ pub enum FilterVariant {
     /// `ekf`: error-state extended Kalman filter with the fixed noise of this file; the
     /// baseline the adaptive variants are measured against.
     Ekf,
+    /// `eiakf`: innovation-based adaptive R (windowed innovation covariance less H P⁻ Hᵀ),
+    /// enhanced with a whiteness test and an AR(1) correction (the ERMAKF paper's
+    /// reference [24]).
+    Eiakf,
+    /// `srmakf`: the simple redundant-measurement estimator, R = E[∇Z²]/2 over the window
+    /// (ERMAKF paper, eqs. 12–18).
+    Srmakf,
+    /// `ermakf`: the enhanced redundant-measurement AKF: random weighting (eq. 19), KDE
+    /// detection (eqs. 20–24) and the Burg/Akaike AR variance (eqs. 25–29).
+    Ermakf,
 }
 
 impl FilterVariant {
+    /// Every variant, in the order of the documentation.
+    pub const ALL: [FilterVariant; 4] = [Self::Ekf, Self::Eiakf, Self::Srmakf, Self::Ermakf];
+
     /// The name used in the parameter file.
     pub fn as_str(self) -> &'static str {
         match self {
             Self::Ekf => "ekf",
+            Self::Eiakf => "eiakf",
+            Self::Srmakf => "srmakf",
+            Self::Ermakf => "ermakf",
         }
     }
 }
@@ -159,6 +176,51 @@ pub struct LooseConfig {
     pub fix_sigma_vertical_m: f64,
     /// 1σ of each receiver velocity component (m/s), `loose.velocity_sigma_mps` (default `0.1`).
     pub velocity_sigma_mps: f64,
+}
+
+/// `adaptive.*`: the online measurement-noise estimators of the ERMAKF family (used by the
+/// `eiakf`, `srmakf` and `ermakf` variants; ignored by `ekf`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct AdaptiveConfig {
+    /// Window M of the redundant-measurement estimator (epochs), `adaptive.window_size_m`
+    /// (default `100`).
+    pub window_size_m: usize,
+    /// Samples needed before an estimate is trusted (epochs), `adaptive.min_samples`
+    /// (default `30`).
+    pub min_samples: usize,
+    /// Random weighting of the window, eq. (19) (ermakf), `adaptive.random_weighting`
+    /// (default `true`).
+    pub random_weighting: bool,
+    /// Seed of the random weights, `adaptive.random_seed` (default `0`).
+    pub random_seed: u64,
+    /// KDE credibility threshold in standard deviations, `adaptive.kde_threshold`
+    /// (default `3.0`).
+    pub kde_threshold: f64,
+    /// Consecutive epochs that switch the Gaussian verdict, `adaptive.kde_consecutive_epochs`
+    /// (default `3`).
+    pub kde_consecutive_epochs: usize,
+    /// Highest AR order tried, `adaptive.ar_max_order` (default `5`).
+    pub ar_max_order: usize,
+    /// AR order criterion, `adaptive.ar_order_criterion` (default `aic`).
+    pub ar_order_criterion: crate::adaptive::burg::OrderCriterion,
+    /// Floor of the eq. (29) denominator, `adaptive.ar_denominator_floor` (default `0.1`).
+    pub ar_denominator_floor: f64,
+    /// Innovation window of the eiakf (epochs), `adaptive.innovation_window` (default `50`).
+    pub innovation_window: usize,
+    /// Significance of the eiakf whiteness test, `adaptive.innovation_significance`
+    /// (default `0.05`).
+    pub innovation_significance: f64,
+    /// Bounds on the estimated pseudo-range σ (m), `adaptive.pseudorange_sigma_min_m`
+    /// (default `0.3`) and `adaptive.pseudorange_sigma_max_m` (default `150.0`).
+    pub pseudorange_sigma_min_m: f64,
+    pub pseudorange_sigma_max_m: f64,
+    /// Bounds on the estimated rate σ (m/s), `adaptive.pseudorange_rate_sigma_min_mps`
+    /// (default `0.02`) and `adaptive.pseudorange_rate_sigma_max_mps` (default `10.0`).
+    pub pseudorange_rate_sigma_min_mps: f64,
+    pub pseudorange_rate_sigma_max_mps: f64,
+    /// Longest gap between two epochs of a satellite over which ∇Z is still formed (s),
+    /// `adaptive.max_epoch_gap_s` (default `2.0`).
+    pub max_epoch_gap_s: f64,
 }
 
 /// `init.*`: start-up and initial 1σ of the state blocks, in SI.

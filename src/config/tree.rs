@@ -15,6 +15,7 @@ impl RawConfig {
         let c = &self.clock;
         let g = &self.gnss;
         let l = &self.loose;
+        let a = &self.adaptive;
         let n = &self.init;
         let e = &self.engine;
         let o = &self.output;
@@ -92,6 +93,36 @@ impl RawConfig {
                     ("fix_sigma_horizontal_m", num(l.fix_sigma_horizontal_m)),
                     ("fix_sigma_vertical_m", num(l.fix_sigma_vertical_m)),
                     ("velocity_sigma_mps", num(l.velocity_sigma_mps)),
+                ],
+            ),
+            (
+                "adaptive",
+                vec![
+                    ("window_size_m", Value::from(a.window_size_m)),
+                    ("min_samples", Value::from(a.min_samples)),
+                    ("random_weighting", Value::Bool(a.random_weighting)),
+                    ("random_seed", Value::from(a.random_seed)),
+                    ("kde_threshold", num(a.kde_threshold)),
+                    (
+                        "kde_consecutive_epochs",
+                        Value::from(a.kde_consecutive_epochs),
+                    ),
+                    ("ar_max_order", Value::from(a.ar_max_order)),
+                    ("ar_order_criterion", text(a.ar_order_criterion.as_str())),
+                    ("ar_denominator_floor", num(a.ar_denominator_floor)),
+                    ("innovation_window", Value::from(a.innovation_window)),
+                    ("innovation_significance", num(a.innovation_significance)),
+                    ("pseudorange_sigma_min_m", num(a.pseudorange_sigma_min_m)),
+                    ("pseudorange_sigma_max_m", num(a.pseudorange_sigma_max_m)),
+                    (
+                        "pseudorange_rate_sigma_min_mps",
+                        num(a.pseudorange_rate_sigma_min_mps),
+                    ),
+                    (
+                        "pseudorange_rate_sigma_max_mps",
+                        num(a.pseudorange_rate_sigma_max_mps),
+                    ),
+                    ("max_epoch_gap_s", num(a.max_epoch_gap_s)),
                 ],
             ),
             (

@@ -94,6 +94,8 @@ pub fn validate(raw: &RawConfig, origin: &str) -> Result<(), ConfigError> {
     c.positive("loose.fix_sigma_vertical_m", loose.fix_sigma_vertical_m)?;
     c.positive("loose.velocity_sigma_mps", loose.velocity_sigma_mps)?;
 
+    validate_adaptive(raw, &c)?;
+
     let init = &raw.init;
     if let Some(heading) = init.heading_deg {
         c.within(
@@ -150,6 +152,80 @@ pub fn validate(raw: &RawConfig, origin: &str) -> Result<(), ConfigError> {
 
 /// Largest accepted lever-arm component (m).
 const MAX_LEVER_ARM_M: f64 = 100.0;
+
+fn validate_adaptive(raw: &RawConfig, c: &Checker) -> Result<(), ConfigError> {
+    let a = &raw.adaptive;
+    let count = |key: &str, value: usize, min: usize| {
+        if value < min {
+            Err(c.invalid(key, value as f64, &format!("must be at least {min}")))
+        } else {
+            Ok(())
+        }
+    };
+    // Choice: a KDE or AR fit on fewer than 10 samples is noise (DESIGN.md pitfalls), and
+    // the AR fit needs the order plus two samples.
+    count("adaptive.window_size_m", a.window_size_m, 10)?;
+    count("adaptive.ar_max_order", a.ar_max_order, 1)?;
+    count(
+        "adaptive.min_samples",
+        a.min_samples,
+        (a.ar_max_order + 2).max(10),
+    )?;
+    if a.min_samples > a.window_size_m {
+        return Err(c.invalid(
+            "adaptive.min_samples",
+            a.min_samples as f64,
+            "must not exceed adaptive.window_size_m",
+        ));
+    }
+    count(
+        "adaptive.kde_consecutive_epochs",
+        a.kde_consecutive_epochs,
+        1,
+    )?;
+    count("adaptive.innovation_window", a.innovation_window, 10)?;
+    c.positive("adaptive.kde_threshold", a.kde_threshold)?;
+    c.within(
+        "adaptive.ar_denominator_floor",
+        a.ar_denominator_floor,
+        1e-3,
+        1.0,
+        "must be within [0.001, 1]",
+    )?;
+    c.within(
+        "adaptive.innovation_significance",
+        a.innovation_significance,
+        1e-6,
+        0.5,
+        "must be within [1e-6, 0.5]",
+    )?;
+    c.positive(
+        "adaptive.pseudorange_sigma_min_m",
+        a.pseudorange_sigma_min_m,
+    )?;
+    c.positive(
+        "adaptive.pseudorange_rate_sigma_min_mps",
+        a.pseudorange_rate_sigma_min_mps,
+    )?;
+    c.positive("adaptive.max_epoch_gap_s", a.max_epoch_gap_s)?;
+    for (key, min, max) in [
+        (
+            "adaptive.pseudorange_sigma_max_m",
+            a.pseudorange_sigma_min_m,
+            a.pseudorange_sigma_max_m,
+        ),
+        (
+            "adaptive.pseudorange_rate_sigma_max_mps",
+            a.pseudorange_rate_sigma_min_mps,
+            a.pseudorange_rate_sigma_max_mps,
+        ),
+    ] {
+        if !(max.is_finite() && max >= min) {
+            return Err(c.invalid(key, max, "must be finite and at least the minimum"));
+        }
+    }
+    Ok(())
+}
 
 fn validate_constellations(raw: &RawConfig, c: &Checker) -> Result<(), ConfigError> {
     let names = &raw.gnss.constellations;
