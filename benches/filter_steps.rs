@@ -4,6 +4,7 @@
 
 use adaptive_gnss_ins::config::Config;
 use adaptive_gnss_ins::earth::{self, Llh};
+use adaptive_gnss_ins::engine::adaptive_noise::NoiseModel;
 use adaptive_gnss_ins::engine::{process_noise, tight_update, FilterState};
 use adaptive_gnss_ins::gnss::GnssEpoch;
 use adaptive_gnss_ins::ins::error_state::StateMatrix;
@@ -93,8 +94,15 @@ fn tc_update(c: &mut Criterion) {
     c.bench_function("tc_update_12_satellites", |b| {
         b.iter(|| {
             let mut state = start.clone();
-            let report = tight_update::update(&mut state, black_box(&epoch), &w, &config, "ekf")
-                .expect("update");
+            let report = tight_update::update(
+                &mut state,
+                black_box(&epoch),
+                &w,
+                &config,
+                &mut NoiseModel::Fixed,
+                true,
+            )
+            .expect("update");
             assert_eq!(report.measurements_used, 24);
         })
     });

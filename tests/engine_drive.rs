@@ -4,7 +4,7 @@
 //! consistent: its NEES (position, velocity, attitude: 9 degrees of freedom) inside the
 //! two-sided 95 % χ² interval on at least 90 % of the epochs.
 
-use adaptive_gnss_ins::config::Config;
+use adaptive_gnss_ins::config::{Config, FilterVariant};
 use adaptive_gnss_ins::earth;
 use adaptive_gnss_ins::engine::{Engine, Output, Solution, StatusEvent};
 use adaptive_gnss_ins::ins::error_state::{DP, DV, PHI};
@@ -140,8 +140,68 @@ fn rms(values: impl Iterator<Item = f64>) -> f64 {
     (sum / n.max(1) as f64).sqrt()
 }
 
+/// Accuracy and consistency of one run.
+struct Metrics {
+    horizontal_m: f64,
+    vertical_m: f64,
+    velocity_mps: f64,
+    roll_pitch_deg: f64,
+    yaw_deg: f64,
+    nees_inside: f64,
+    nees_mean: f64,
+    epochs: usize,
+    rejected_inputs: u64,
+}
+
+impl Metrics {
+    fn assert_within_budgets(&self, name: &str) {
+        println!(
+            "{name}: horizontal {:.3} m, vertical {:.3} m, velocity {:.4} m/s, roll/pitch {:.4}°, \
+             yaw {:.4}°, NEES mean {:.2} (9 dof), inside the 95 % interval on {:.1} % of {} epochs",
+            self.horizontal_m,
+            self.vertical_m,
+            self.velocity_mps,
+            self.roll_pitch_deg,
+            self.yaw_deg,
+            self.nees_mean,
+            self.nees_inside * 100.0,
+            self.epochs
+        );
+        assert!(self.epochs > 200, "{name}: {} scored epochs", self.epochs);
+        assert!(self.horizontal_m < MAX_HORIZONTAL_RMSE_M, "{name}");
+        assert!(self.vertical_m < MAX_VERTICAL_RMSE_M, "{name}");
+        assert!(self.velocity_mps < MAX_VELOCITY_RMSE_MPS, "{name}");
+        assert!(self.roll_pitch_deg < MAX_ROLL_PITCH_RMSE_DEG, "{name}");
+        assert!(self.yaw_deg < MAX_YAW_RMSE_DEG, "{name}");
+        assert!(
+            self.nees_inside >= 0.9,
+            "{name}: NEES inside on too few epochs"
+        );
+        assert_eq!(self.rejected_inputs, 0, "{name}");
+    }
+}
+
 #[test]
 fn tightly_coupled_ekf_on_an_open_sky_drive() {
+    run_drive(Config::default()).assert_within_budgets("ekf");
+}
+
+/// In open sky with white noise of the nominal σ, the adaptive variants must do as well
+/// as the EKF (their estimates converge to the nominal variances).
+#[test]
+fn adaptive_variants_on_an_open_sky_drive() {
+    for variant in [
+        FilterVariant::Eiakf,
+        FilterVariant::Srmakf,
+        FilterVariant::Ermakf,
+    ] {
+        let mut config = Config::default();
+        config.filter.variant = variant;
+        run_drive(config).assert_within_budgets(variant.as_str());
+    }
+}
+
+fn run_drive(config: Config) -> Metrics {
     let trajectory = Trajectory::new(&drive()).unwrap();
     let imu_rate_hz = 100.0;
     let mut imu_errors = ImuErrorModel::new(&ImuErrorSpec::default(), imu_rate_hz, 42).unwrap();
@@ -153,7 +213,7 @@ fn tightly_coupled_ekf_on_an_open_sky_drive() {
     let mut rng = ChaCha8Rng::seed_from_u64(7);
     let unit = Normal::new(0.0, 1.0).unwrap();
     let (clock0_m, drift_mps) = (3_000.0, -25.0);
-    let mut engine = Engine::new(Config::default());
+    let mut engine = Engine::new(config);
     let mut scored = Vec::new();
     let mut t_init = None;
     for truth in trajectory.samples(imu_rate_hz).unwrap() {
@@ -202,39 +262,26 @@ fn tightly_coupled_ekf_on_an_open_sky_drive() {
     }
     let t0 = t_init.expect("the filter started");
     assert!(t0 < 30.0, "started at {t0} s");
-    assert!(scored.len() > 200, "{} scored epochs", scored.len());
-    let h = rms(scored.iter().map(|s| s.pos.xy().norm()));
-    let v = rms(scored.iter().map(|s| s.pos[2]));
-    let vel = rms(scored.iter().map(|s| s.vel.norm()));
-    let roll_pitch = rms(scored
-        .iter()
-        .flat_map(|s| [s.roll_pitch_yaw_err[0], s.roll_pitch_yaw_err[1]]))
-    .to_degrees()
-        * std::f64::consts::SQRT_2;
-    let yaw = rms(scored.iter().map(|s| s.roll_pitch_yaw_err[2])).to_degrees();
     let chi2 = ChiSquared::new(9.0).unwrap();
     let (lo, hi) = (chi2.inverse_cdf(0.025), chi2.inverse_cdf(0.975));
-    let inside = scored
-        .iter()
-        .filter(|s| s.nees >= lo && s.nees <= hi)
-        .count() as f64
-        / scored.len() as f64;
-    let mean_nees = scored.iter().map(|s| s.nees).sum::<f64>() / scored.len() as f64;
-    println!(
-        "horizontal {h:.3} m, vertical {v:.3} m, velocity {vel:.4} m/s, roll/pitch {roll_pitch:.4}°, yaw {yaw:.4}°, \
-         NEES mean {mean_nees:.2} (9 dof), inside [{lo:.2}, {hi:.2}] on {:.1} % of {} epochs",
-        inside * 100.0,
-        scored.len()
-    );
-    assert!(h < MAX_HORIZONTAL_RMSE_M);
-    assert!(v < MAX_VERTICAL_RMSE_M);
-    assert!(vel < MAX_VELOCITY_RMSE_MPS);
-    assert!(roll_pitch < MAX_ROLL_PITCH_RMSE_DEG);
-    assert!(yaw < MAX_YAW_RMSE_DEG);
-    assert!(
-        inside >= 0.9,
-        "NEES inside the 95 % interval on only {:.1} % of epochs",
-        inside * 100.0
-    );
-    assert_eq!(engine.counters().total(), 0);
+    let n = scored.len() as f64;
+    Metrics {
+        horizontal_m: rms(scored.iter().map(|s| s.pos.xy().norm())),
+        vertical_m: rms(scored.iter().map(|s| s.pos[2])),
+        velocity_mps: rms(scored.iter().map(|s| s.vel.norm())),
+        roll_pitch_deg: rms(scored
+            .iter()
+            .flat_map(|s| [s.roll_pitch_yaw_err[0], s.roll_pitch_yaw_err[1]]))
+        .to_degrees()
+            * std::f64::consts::SQRT_2,
+        yaw_deg: rms(scored.iter().map(|s| s.roll_pitch_yaw_err[2])).to_degrees(),
+        nees_inside: scored
+            .iter()
+            .filter(|s| s.nees >= lo && s.nees <= hi)
+            .count() as f64
+            / n,
+        nees_mean: scored.iter().map(|s| s.nees).sum::<f64>() / n,
+        epochs: scored.len(),
+        rejected_inputs: engine.counters().total(),
+    }
 }

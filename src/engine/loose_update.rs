@@ -73,7 +73,6 @@ pub fn update(
     fix: &GnssFix,
     w_ib_b_rad_s: &Vector3<f64>,
     config: &Config,
-    variant: &'static str,
 ) -> Result<EpochReport, FilterError> {
     let geo = AntennaGeometry::new(&state.nav, &config.mounting.lever_arm_b_m, w_ib_b_rad_s);
     // Position innovation in the ENU frame at the nominal point (predicted − measured).
@@ -103,13 +102,8 @@ pub fn update(
     let result = ekf::update(&state.p, &h, &y, &r, config.filter.joseph_form)?;
     state.p = result.p;
     state.apply_correction(&result.dx);
-    Ok(EpochReport {
-        t_s: fix.t_s,
-        kind: MeasurementKind::Fix,
-        variant,
-        satellites: Vec::new(),
-        measurements_used: m,
-        nis: result.nis,
-        clock_jump_m: 0.0,
-    })
+    let mut report = EpochReport::new(fix.t_s, MeasurementKind::Fix, config);
+    report.measurements_used = m;
+    report.nis = result.nis;
+    Ok(report)
 }

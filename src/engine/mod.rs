@@ -14,6 +14,7 @@
 //!   the last stored state before it, applies it, and re-integrates the buffered IMU
 //!   samples; one older than `engine.imu_buffer_s` is rejected and counted.
 
+pub mod adaptive_noise;
 mod filter_state;
 mod initializer;
 pub mod loose_update;
@@ -27,6 +28,8 @@ use crate::config::{Config, Coupling};
 use crate::filter::process_model::ProcessNoise;
 use crate::gnss::GnssEpoch;
 use crate::ins::ImuSample;
+
+use adaptive_noise::NoiseModel;
 
 pub use filter_state::{interpolate, FilterState};
 pub use initializer::{InitPhase, Initializer};
@@ -77,7 +80,7 @@ enum Phase {
 #[derive(Debug, Clone)]
 pub struct Engine {
     config: Config,
-    noise: ProcessNoise,
+    process_noise: ProcessNoise,
     phase: Phase,
     /// Raw body-frame IMU samples of the last `imu_buffer_s`.
     imu: VecDeque<ImuSample>,
@@ -88,14 +91,16 @@ pub struct Engine {
     counters: RejectionCounters,
     /// Solutions are not emitted while re-integrating after a roll-back.
     replaying: bool,
+    noise_model: NoiseModel,
 }
 
 impl Engine {
     pub fn new(config: Config) -> Self {
-        let noise = process_noise(&config);
+        let process_noise = process_noise(&config);
         Self {
+            noise_model: NoiseModel::new(&config),
             config,
-            noise,
+            process_noise,
             phase: Phase::Initializing(Box::default()),
             imu: VecDeque::new(),
             history: VecDeque::new(),
@@ -153,6 +158,7 @@ impl Engine {
             Phase::Initializing(_) => Box::default(),
         };
         self.phase = Phase::Initializing(init);
+        self.noise_model.reset();
         self.imu.clear();
         self.history.clear();
         self.pending.clear();
@@ -343,7 +349,7 @@ impl Engine {
             Phase::Initializing(init) => init.push_imu(s, &self.config),
             Phase::Running(state) => {
                 if state.last_imu.t_s < s.t_s {
-                    if let Err(e) = state.propagate(s, &self.noise) {
+                    if let Err(e) = state.propagate(s, &self.process_noise) {
                         log::warn!("IMU step to t = {:.6} s failed: {e}", s.t_s);
                         self.counters.reject(RejectionReason::ImuStepFailed, s.t_s);
                         let reset = self.reset(s.t_s, ResetReason::Diverged);
@@ -401,22 +407,20 @@ impl Engine {
             Phase::Running(state) => {
                 if state.last_imu.t_s < t {
                     let at_t = interpolate(&state.last_imu, next, t);
-                    if let Err(e) = state.propagate(&at_t, &self.noise) {
+                    if let Err(e) = state.propagate(&at_t, &self.process_noise) {
                         log::warn!("IMU step to the measurement at t = {t:.6} s failed: {e}");
                         self.counters.reject(RejectionReason::ImuStepFailed, t);
                         return;
                     }
                 }
                 let w = state.compensate(&state.last_imu).w_ib_b_rad_s;
-                let variant = self.config.filter.variant.as_str();
                 let before = state.as_ref().clone();
+                let noise = &mut self.noise_model;
                 let result = match &p.measurement {
                     Measurement::Gnss(e) => {
-                        tight_update::update(state, e, &w, &self.config, variant)
+                        tight_update::update(state, e, &w, &self.config, noise, report)
                     }
-                    Measurement::Fix(f) => {
-                        loose_update::update(state, f, &w, &self.config, variant)
-                    }
+                    Measurement::Fix(f) => loose_update::update(state, f, &w, &self.config),
                 };
                 match result {
                     Ok(epoch) if state.is_finite() => {

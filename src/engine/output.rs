@@ -3,6 +3,7 @@
 
 use nalgebra::{Matrix3, SMatrix, Vector3};
 
+use crate::config::Config;
 use crate::earth;
 use crate::gnss::SatId;
 use crate::ins::error_state::{StateMatrix, DP, DV, PHI};
@@ -110,6 +111,14 @@ pub struct SatReport {
     pub r_pseudorange_m2: f64,
     /// Measurement variance used for the rate ((m/s)²).
     pub r_rate_m2_s2: f64,
+    /// KDE density of the newest pseudo-range mutual difference (NaN: not computed).
+    pub kde_credibility: f64,
+    /// Gaussian verdict of the KDE test (None: not computed).
+    pub gaussian: Option<bool>,
+    /// Order of the AR model in use for the pseudo-range (None: none).
+    pub ar_order: Option<u8>,
+    /// Weight factor of a robust scheme, 1 = full weight (NaN: no robust scheme).
+    pub robust_weight: f64,
 }
 
 impl SatReport {
@@ -126,6 +135,10 @@ impl SatReport {
             normalized_innovation_rate: f64::NAN,
             r_pseudorange_m2: f64::NAN,
             r_rate_m2_s2: f64::NAN,
+            kde_credibility: f64::NAN,
+            gaussian: None,
+            ar_order: None,
+            robust_weight: f64::NAN,
         }
     }
 }
@@ -153,6 +166,33 @@ pub struct EpochReport {
     pub nis: f64,
     /// A receiver clock jump absorbed in this epoch (m), 0 if none.
     pub clock_jump_m: f64,
+    /// Adaptive factor α of an adaptive scheme (NaN: none).
+    pub adaptive_factor: f64,
+    /// Mahalanobis distance² of the innovation vector (NaN: not tested).
+    pub mahalanobis_d2: f64,
+    /// χ² threshold the distance was tested against (NaN: not tested).
+    pub chi2_threshold: f64,
+    /// Process-noise scale in use (1 = the configured Q).
+    pub q_scale: f64,
+}
+
+impl EpochReport {
+    /// An empty report of the configured variant.
+    pub fn new(t_s: f64, kind: MeasurementKind, config: &Config) -> Self {
+        Self {
+            t_s,
+            kind,
+            variant: config.filter.variant.as_str(),
+            satellites: Vec::new(),
+            measurements_used: 0,
+            nis: f64::NAN,
+            clock_jump_m: 0.0,
+            adaptive_factor: f64::NAN,
+            mahalanobis_d2: f64::NAN,
+            chi2_threshold: f64::NAN,
+            q_scale: 1.0,
+        }
+    }
 }
 
 /// Life-cycle events.

@@ -11,6 +11,7 @@ use crate::gnss::geometry::{self, SatPrediction};
 use crate::gnss::spp::SigmaModel;
 use crate::gnss::GnssEpoch;
 
+use super::adaptive_noise::{NoiseModel, Observable, ScalarMeasurement};
 use super::filter_state::FilterState;
 use super::output::{EpochReport, MeasurementKind, SatRejection, SatReport};
 
@@ -18,11 +19,24 @@ use super::output::{EpochReport, MeasurementKind, SatRejection, SatReport};
 struct Candidate {
     /// Index into the report's satellites.
     sat_index: usize,
-    is_rate: bool,
+    /// Index into the epoch's satellites.
+    obs_index: usize,
+    observable: Observable,
     row: Row,
-    /// Predicted − measured.
-    y: f64,
+    measured: f64,
+    predicted: f64,
     r: f64,
+}
+
+impl Candidate {
+    /// Predicted − measured.
+    fn y(&self) -> f64 {
+        self.predicted - self.measured
+    }
+
+    fn is_rate(&self) -> bool {
+        self.observable == Observable::PseudorangeRate
+    }
 }
 
 /// The measurement σ model of the configuration.
@@ -41,58 +55,51 @@ pub fn sigma_model(config: &Config) -> SigmaModel {
 }
 
 /// Updates `state` with `epoch`; `w_ib_b_rad_s` is the compensated body rate at the epoch
-/// (for the lever-arm velocity). Returns the epoch report; on a filter failure the state
-/// is unchanged and the error is returned.
+/// (for the lever-arm velocity); `noise` gives the variances (with `learn` false for
+/// measurements re-applied after a roll-back). Returns the epoch report; on a filter
+/// failure the state is unchanged and the error is returned.
 pub fn update(
     state: &mut FilterState,
     epoch: &GnssEpoch,
     w_ib_b_rad_s: &Vector3<f64>,
     config: &Config,
-    variant: &'static str,
+    noise: &mut NoiseModel,
+    learn: bool,
 ) -> Result<EpochReport, FilterError> {
     let geo = AntennaGeometry::new(&state.nav, &config.mounting.lever_arm_b_m, w_ib_b_rad_s);
     let rx_pos = geo.antenna_ecef_m(&state.nav.p);
     let rx_vel = geo.antenna_velocity_ecef_mps(&state.nav.v_n);
     let sigmas = sigma_model(config);
-    let mut report = EpochReport {
-        t_s: epoch.t_s,
-        kind: MeasurementKind::Pseudoranges,
-        variant,
-        satellites: Vec::with_capacity(epoch.satellites.len()),
-        measurements_used: 0,
-        nis: f64::NAN,
-        clock_jump_m: 0.0,
-    };
+    let mut report = EpochReport::new(epoch.t_s, MeasurementKind::Pseudoranges, config);
     let mut candidates = Vec::with_capacity(2 * epoch.satellites.len());
-    for obs in &epoch.satellites {
+    for (obs_index, obs) in epoch.satellites.iter().enumerate() {
         let mut sat = SatReport::new(obs.sat);
-        let prediction = screen(obs, &rx_pos, &rx_vel, state, epoch, config);
-        match prediction {
+        match screen(obs, &rx_pos, &rx_vel, state, epoch, config) {
             Err(reason) => sat.rejection = Some(reason),
             Ok(pred) => {
                 sat.elevation_rad = pred.elevation_rad;
-                let index = report.satellites.len();
+                let sat_index = report.satellites.len();
                 let el = Some(pred.elevation_rad);
-                let r = sigmas.pseudorange_sigma_m(obs, el).powi(2);
-                sat.r_pseudorange_m2 = r;
                 candidates.push(Candidate {
-                    sat_index: index,
-                    is_rate: false,
+                    sat_index,
+                    obs_index,
+                    observable: Observable::Pseudorange,
                     row: geo.pseudorange_row(&pred.los_ecef),
-                    y: pred.pseudorange_m - obs.pseudorange_m,
-                    r,
+                    measured: obs.pseudorange_m,
+                    predicted: pred.pseudorange_m,
+                    r: sigmas.pseudorange_sigma_m(obs, el).powi(2),
                 });
                 if let (true, Some(rate)) =
                     (config.gnss.use_pseudorange_rate, obs.pseudorange_rate_mps)
                 {
-                    let r = sigmas.pseudorange_rate_sigma_mps(obs, el).powi(2);
-                    sat.r_rate_m2_s2 = r;
                     candidates.push(Candidate {
-                        sat_index: index,
-                        is_rate: true,
+                        sat_index,
+                        obs_index,
+                        observable: Observable::PseudorangeRate,
                         row: geo.pseudorange_rate_row(&pred.los_ecef),
-                        y: pred.pseudorange_rate_mps - rate,
-                        r,
+                        measured: rate,
+                        predicted: pred.pseudorange_rate_mps,
+                        r: sigmas.pseudorange_rate_sigma_mps(obs, el).powi(2),
                     });
                 }
             }
@@ -100,43 +107,113 @@ pub fn update(
         report.satellites.push(sat);
     }
     report.clock_jump_m = absorb_clock_jump(state, &mut candidates, config.gnss.max_clock_jump_m);
+    let scalars: Vec<ScalarMeasurement> = candidates
+        .iter()
+        .map(|c| ScalarMeasurement {
+            sat: report.satellites[c.sat_index].sat,
+            observable: c.observable,
+            measured: c.measured,
+            predicted: c.predicted,
+            hph: (c.row * state.p * c.row.transpose())[(0, 0)],
+            r_nominal: c.r,
+        })
+        .collect();
+    let verdicts = noise.variances(epoch.t_s, &scalars, learn);
+    for (c, v) in candidates.iter_mut().zip(&verdicts) {
+        c.r = v.r;
+        let sat = &mut report.satellites[c.sat_index];
+        if c.is_rate() {
+            sat.r_rate_m2_s2 = v.r;
+        } else {
+            sat.r_pseudorange_m2 = v.r;
+            // Choice: the per-satellite KDE fields of the diagnostics describe the
+            // pseudo-range, the observable the multipath acts on most.
+            sat.kde_credibility = v.kde_credibility;
+            sat.gaussian = v.gaussian;
+            sat.ar_order = v.ar_order;
+        }
+    }
+    let screened: Vec<(usize, ScalarMeasurement)> = candidates
+        .iter()
+        .map(|c| c.obs_index)
+        .zip(scalars)
+        .collect();
     gate(
         &mut candidates,
         &state.p,
         config.gnss.innovation_gate_sigma,
         &mut report,
     );
-    if candidates.is_empty() {
-        return Ok(report);
-    }
-    let m = candidates.len();
-    let mut h = DMatrix::zeros(m, crate::ins::error_state::N);
-    let mut y = DVector::zeros(m);
-    let mut r = DMatrix::zeros(m, m);
-    for (i, c) in candidates.iter().enumerate() {
-        h.row_mut(i).copy_from(&c.row);
-        y[i] = c.y;
-        r[(i, i)] = c.r;
-    }
-    let result = ekf::update(&state.p, &h, &y, &r, config.filter.joseph_form)?;
-    for (i, c) in candidates.iter().enumerate() {
-        let sat = &mut report.satellites[c.sat_index];
-        let normalized = -c.y / result.s[(i, i)].sqrt();
-        if c.is_rate {
-            sat.used_rate = true;
-            sat.innovation_rate_mps = -c.y;
-            sat.normalized_innovation_rate = normalized;
-        } else {
-            sat.used_pseudorange = true;
-            sat.innovation_pseudorange_m = -c.y;
-            sat.normalized_innovation_pseudorange = normalized;
+    if !candidates.is_empty() {
+        let m = candidates.len();
+        let mut h = DMatrix::zeros(m, crate::ins::error_state::N);
+        let mut y = DVector::zeros(m);
+        let mut r = DMatrix::zeros(m, m);
+        for (i, c) in candidates.iter().enumerate() {
+            h.row_mut(i).copy_from(&c.row);
+            y[i] = c.y();
+            r[(i, i)] = c.r;
         }
+        let result = ekf::update(&state.p, &h, &y, &r, config.filter.joseph_form)?;
+        for (i, c) in candidates.iter().enumerate() {
+            let sat = &mut report.satellites[c.sat_index];
+            let normalized = -c.y() / result.s[(i, i)].sqrt();
+            if c.is_rate() {
+                sat.used_rate = true;
+                sat.innovation_rate_mps = -c.y();
+                sat.normalized_innovation_rate = normalized;
+            } else {
+                sat.used_pseudorange = true;
+                sat.innovation_pseudorange_m = -c.y();
+                sat.normalized_innovation_pseudorange = normalized;
+            }
+        }
+        state.p = result.p;
+        state.apply_correction(&result.dx);
+        report.measurements_used = m;
+        report.nis = result.nis;
     }
-    state.p = result.p;
-    state.apply_correction(&result.dx);
-    report.measurements_used = m;
-    report.nis = result.nis;
+    if learn && noise.wants_posterior_predictions() {
+        let (rows, posterior) = posterior_predictions(state, epoch, w_ib_b_rad_s, config, screened);
+        noise.after_update(epoch.t_s, &rows, &posterior);
+    }
     Ok(report)
+}
+
+/// The screened measurements with their predictions from the corrected state (NaN where
+/// the prediction fails).
+fn posterior_predictions(
+    state: &FilterState,
+    epoch: &GnssEpoch,
+    w_ib_b_rad_s: &Vector3<f64>,
+    config: &Config,
+    screened: Vec<(usize, ScalarMeasurement)>,
+) -> (Vec<ScalarMeasurement>, Vec<f64>) {
+    let geo = AntennaGeometry::new(&state.nav, &config.mounting.lever_arm_b_m, w_ib_b_rad_s);
+    let rx_pos = geo.antenna_ecef_m(&state.nav.p);
+    let rx_vel = geo.antenna_velocity_ecef_mps(&state.nav.v_n);
+    let mut posterior = Vec::with_capacity(screened.len());
+    let mut rows = Vec::with_capacity(screened.len());
+    for (obs_index, row) in screened {
+        let value = epoch.satellites.get(obs_index).and_then(|obs| {
+            geometry::predict(
+                obs,
+                &rx_pos,
+                &rx_vel,
+                state.clock_bias_m,
+                state.clock_drift_mps,
+                epoch.klobuchar.as_ref(),
+                epoch.gps_time_of_week_s,
+            )
+            .ok()
+        });
+        posterior.push(value.map_or(f64::NAN, |p| match row.observable {
+            Observable::Pseudorange => p.pseudorange_m,
+            Observable::PseudorangeRate => p.pseudorange_rate_mps,
+        }));
+        rows.push(row);
+    }
+    (rows, posterior)
 }
 
 /// Checks one observation against the masks and predicts it.
@@ -200,15 +277,15 @@ fn absorb_clock_jump(
 ) -> f64 {
     let mut ys: Vec<f64> = candidates
         .iter()
-        .filter(|c| !c.is_rate)
-        .map(|c| c.y)
+        .filter(|c| !c.is_rate())
+        .map(Candidate::y)
         .collect();
     match median(&mut ys) {
         Some(common) if common.abs() > threshold_m => {
             // y = predicted − measured: a jump +J of the receiver clock gives y = −J.
             state.clock_bias_m -= common;
-            for c in candidates.iter_mut().filter(|c| !c.is_rate) {
-                c.y -= common;
+            for c in candidates.iter_mut().filter(|c| !c.is_rate()) {
+                c.predicted -= common;
             }
             -common
         }
@@ -234,8 +311,8 @@ fn gate(
     let common = |is_rate: bool, cands: &[Candidate]| {
         let mut ys: Vec<f64> = cands
             .iter()
-            .filter(|c| c.is_rate == is_rate)
-            .map(|c| c.y)
+            .filter(|c| c.is_rate() == is_rate)
+            .map(Candidate::y)
             .collect();
         if ys.len() >= 3 {
             median(&mut ys).unwrap_or(0.0)
@@ -247,19 +324,23 @@ fn gate(
     let common_rate = common(true, candidates);
     candidates.retain(|c| {
         let s = (c.row * p * c.row.transpose())[(0, 0)] + c.r;
-        let offset = if c.is_rate { common_rate } else { common_range };
-        let keep = (c.y - offset).abs() <= gate_sigma * s.sqrt();
+        let offset = if c.is_rate() {
+            common_rate
+        } else {
+            common_range
+        };
+        let keep = (c.y() - offset).abs() <= gate_sigma * s.sqrt();
         if !keep {
             let sat = &mut report.satellites[c.sat_index];
             if sat.rejection.is_none() {
                 sat.rejection = Some(SatRejection::InnovationGate);
             }
-            if c.is_rate {
-                sat.innovation_rate_mps = -c.y;
-                sat.normalized_innovation_rate = -c.y / s.sqrt();
+            if c.is_rate() {
+                sat.innovation_rate_mps = -c.y();
+                sat.normalized_innovation_rate = -c.y() / s.sqrt();
             } else {
-                sat.innovation_pseudorange_m = -c.y;
-                sat.normalized_innovation_pseudorange = -c.y / s.sqrt();
+                sat.innovation_pseudorange_m = -c.y();
+                sat.normalized_innovation_pseudorange = -c.y() / s.sqrt();
             }
         }
         keep

@@ -1,0 +1,112 @@
+//! The innovation-based strategy (eiakf), the ERMAKF paper's baseline after its reference
+//! [24]: per satellite and observable, R̂ = Ĉ_ν − h P⁻ hᵀ over a window of innovations,
+//! with a whiteness test and an AR(1) (Yule-Walker) correction when the innovations are
+//! correlated (see [`crate::adaptive::innovation`]). The innovation of the current epoch
+//! is in its own window: the paper's reference estimates R before each update.
+
+use std::collections::HashMap;
+
+use crate::adaptive::innovation::{
+    InnovationCovarianceEstimator, InnovationOptions, InnovationOutcome,
+};
+use crate::config::Config;
+use crate::gnss::SatId;
+
+use super::{variance_bounds, NoiseVerdict, Observable, ScalarMeasurement};
+
+#[derive(Debug, Clone)]
+struct Track {
+    estimator: InnovationCovarianceEstimator,
+    last_t_s: f64,
+    last_verdict: Option<NoiseVerdict>,
+}
+
+/// Innovation-based noise estimation for every satellite and observable.
+#[derive(Debug, Clone)]
+pub struct InnovationNoise {
+    options: InnovationOptions,
+    bounds: [(f64, f64); 2],
+    max_gap_s: f64,
+    tracks: HashMap<(SatId, Observable), Track>,
+}
+
+impl InnovationNoise {
+    pub fn new(config: &Config) -> Self {
+        let a = &config.adaptive;
+        let options = InnovationOptions {
+            window_size: a.innovation_window,
+            min_samples: a.min_samples.min(a.innovation_window),
+            significance: a.innovation_significance,
+            ar_denominator_floor: a.ar_denominator_floor,
+            ..InnovationOptions::default()
+        };
+        Self {
+            options,
+            bounds: [
+                variance_bounds(config, Observable::Pseudorange),
+                variance_bounds(config, Observable::PseudorangeRate),
+            ],
+            max_gap_s: a.max_epoch_gap_s,
+            tracks: HashMap::new(),
+        }
+    }
+
+    pub fn variances(
+        &mut self,
+        t_s: f64,
+        rows: &[ScalarMeasurement],
+        learn: bool,
+    ) -> Vec<NoiseVerdict> {
+        rows.iter()
+            .map(|row| self.variance(t_s, row, learn))
+            .collect()
+    }
+
+    fn variance(&mut self, t_s: f64, row: &ScalarMeasurement, learn: bool) -> NoiseVerdict {
+        let (r_min, r_max) = match row.observable {
+            Observable::Pseudorange => self.bounds[0],
+            Observable::PseudorangeRate => self.bounds[1],
+        };
+        let track = match self.tracks.entry((row.sat, row.observable)) {
+            std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
+            std::collections::hash_map::Entry::Vacant(e) => {
+                let Ok(estimator) = InnovationCovarianceEstimator::new(self.options.clone()) else {
+                    return NoiseVerdict::nominal(row.r_nominal);
+                };
+                e.insert(Track {
+                    estimator,
+                    last_t_s: f64::NEG_INFINITY,
+                    last_verdict: None,
+                })
+            }
+        };
+        if !learn || t_s <= track.last_t_s {
+            return track
+                .last_verdict
+                .unwrap_or_else(|| NoiseVerdict::nominal(row.r_nominal));
+        }
+        if t_s - track.last_t_s > self.max_gap_s {
+            track.estimator.reset();
+        }
+        track.last_t_s = t_s;
+        let innovation = row.measured - row.predicted;
+        let verdict = match track.estimator.push(innovation, row.hph) {
+            Ok(InnovationOutcome::Ready(est)) => NoiseVerdict {
+                r: est.r_variance.clamp(r_min, r_max),
+                estimated: true,
+                kde_credibility: f64::NAN,
+                gaussian: None,
+                ar_order: est.correlated.then_some(1),
+            },
+            Ok(InnovationOutcome::NotEnoughData { .. }) | Err(_) => {
+                NoiseVerdict::nominal(row.r_nominal)
+            }
+        };
+        track.last_verdict = verdict.estimated.then_some(verdict);
+        verdict
+    }
+
+    pub fn reset(&mut self) {
+        self.tracks.clear();
+    }
+}

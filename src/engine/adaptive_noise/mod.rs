@@ -1,0 +1,145 @@
+//! The measurement-noise strategies of the filter variants: fixed (ekf), innovation-based
+//! (eiakf) and redundant-measurement based (srmakf, ermakf). Each is asked, per epoch, for
+//! the variance R of every scalar measurement, one estimator per satellite and observable.
+
+mod innovation;
+mod redundant;
+
+use crate::config::{Config, FilterVariant};
+use crate::gnss::SatId;
+
+pub use innovation::InnovationNoise;
+pub use redundant::RedundantNoise;
+
+/// Which observable a scalar measurement is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Observable {
+    Pseudorange,
+    PseudorangeRate,
+}
+
+/// One scalar measurement of an epoch, as the noise strategies see it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ScalarMeasurement {
+    pub sat: SatId,
+    pub observable: Observable,
+    /// The receiver's value (m or m/s).
+    pub measured: f64,
+    /// The value predicted from the prior (INS) state (m or m/s).
+    pub predicted: f64,
+    /// h P⁻ hᵀ of its row.
+    pub hph: f64,
+    /// The variance of the fixed σ model (gnss.*), used until an estimate is trusted.
+    pub r_nominal: f64,
+}
+
+/// A strategy's answer for one scalar measurement.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NoiseVerdict {
+    /// The variance to use.
+    pub r: f64,
+    /// True when `r` is an online estimate (false: the nominal variance).
+    pub estimated: bool,
+    /// KDE density of the newest mutual difference (NaN: not computed).
+    pub kde_credibility: f64,
+    /// Gaussian verdict of the KDE test (None: not computed).
+    pub gaussian: Option<bool>,
+    /// Order of the AR model in use (None: not in use).
+    pub ar_order: Option<u8>,
+}
+
+impl NoiseVerdict {
+    /// The nominal variance, nothing estimated.
+    pub fn nominal(r: f64) -> Self {
+        Self {
+            r,
+            estimated: false,
+            kde_credibility: f64::NAN,
+            gaussian: None,
+            ar_order: None,
+        }
+    }
+}
+
+/// The noise strategy of the configured variant.
+#[derive(Debug, Clone)]
+pub enum NoiseModel {
+    /// The fixed σ model of `gnss.*`.
+    Fixed,
+    Innovation(Box<InnovationNoise>),
+    Redundant(Box<RedundantNoise>),
+}
+
+impl NoiseModel {
+    pub fn new(config: &Config) -> Self {
+        match config.filter.variant {
+            FilterVariant::Ekf => Self::Fixed,
+            FilterVariant::Eiakf => Self::Innovation(Box::new(InnovationNoise::new(config))),
+            FilterVariant::Srmakf => Self::Redundant(Box::new(RedundantNoise::new(config, false))),
+            FilterVariant::Ermakf => Self::Redundant(Box::new(RedundantNoise::new(config, true))),
+        }
+    }
+
+    /// The variances of an epoch's measurements, in the same order. With `learn` false
+    /// (measurements re-applied after a roll-back) the estimators are only read.
+    pub fn variances(
+        &mut self,
+        t_s: f64,
+        rows: &[ScalarMeasurement],
+        learn: bool,
+    ) -> Vec<NoiseVerdict> {
+        match self {
+            Self::Fixed => rows
+                .iter()
+                .map(|r| NoiseVerdict::nominal(r.r_nominal))
+                .collect(),
+            Self::Innovation(m) => m.variances(t_s, rows, learn),
+            Self::Redundant(m) => m.variances(t_s, rows, learn),
+        }
+    }
+
+    /// True when the strategy needs the predictions of the corrected state.
+    pub fn wants_posterior_predictions(&self) -> bool {
+        matches!(self, Self::Redundant(_))
+    }
+
+    /// Hands over the measurements with their predictions from the corrected state.
+    pub fn after_update(&mut self, t_s: f64, rows: &[ScalarMeasurement], posterior: &[f64]) {
+        if let Self::Redundant(m) = self {
+            m.after_update(t_s, rows, posterior);
+        }
+    }
+
+    /// Forgets every estimate (after a filter reset).
+    pub fn reset(&mut self) {
+        match self {
+            Self::Fixed => {}
+            Self::Innovation(m) => m.reset(),
+            Self::Redundant(m) => m.reset(),
+        }
+    }
+}
+
+/// The variance bounds of the configuration for an observable.
+pub(crate) fn variance_bounds(config: &Config, observable: Observable) -> (f64, f64) {
+    let a = &config.adaptive;
+    match observable {
+        Observable::Pseudorange => (
+            a.pseudorange_sigma_min_m.powi(2),
+            a.pseudorange_sigma_max_m.powi(2),
+        ),
+        Observable::PseudorangeRate => (
+            a.pseudorange_rate_sigma_min_mps.powi(2),
+            a.pseudorange_rate_sigma_max_mps.powi(2),
+        ),
+    }
+}
+
+/// A seed per satellite and observable derived from the configured one, so that every
+/// estimator draws its own reproducible random weights.
+pub(crate) fn estimator_seed(base: u64, sat: SatId, observable: Observable) -> u64 {
+    let id = (u64::from(sat.constellation.code()) << 17)
+        | (u64::from(sat.prn) << 1)
+        | u64::from(observable == Observable::PseudorangeRate);
+    base.wrapping_mul(0x9E37_79B9_7F4A_7C15).wrapping_add(id)
+}
