@@ -20,6 +20,7 @@ pub mod adaptive;
 pub mod config;
 pub mod earth;
 pub mod engine;
+pub mod eval;
 pub mod filter;
 pub mod gnss;
 pub mod ins;

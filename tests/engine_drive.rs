@@ -6,14 +6,12 @@
 
 use adaptive_gnss_ins::config::{Config, FilterVariant};
 use adaptive_gnss_ins::earth;
-use adaptive_gnss_ins::engine::{Engine, Output, Solution, StatusEvent};
-use adaptive_gnss_ins::ins::error_state::{DP, DV, PHI};
-use adaptive_gnss_ins::ins::NavState;
+use adaptive_gnss_ins::engine::{Engine, Output, StatusEvent};
+use adaptive_gnss_ins::eval;
 use adaptive_gnss_ins::sim::constellation::{
     AtmosphereTruth, GpsConstellation, ObservationNoise, ReceiverTruth,
 };
 use adaptive_gnss_ins::sim::{ImuErrorModel, ImuErrorSpec, Segment, Trajectory, TrajectorySpec};
-use nalgebra::{SMatrix, SVector, Vector3};
 use rand_chacha::rand_core::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
@@ -92,46 +90,6 @@ fn drive() -> TrajectorySpec {
             },
             Cruise { duration_s: 30.0 },
         ],
-    }
-}
-
-/// Errors of one solution against the truth: ENU position (m), ENU velocity (m/s),
-/// attitude φ (rad), and the NEES of the 9 together.
-struct Scored {
-    pos: Vector3<f64>,
-    vel: Vector3<f64>,
-    roll_pitch_yaw_err: Vector3<f64>,
-    nees: f64,
-}
-
-fn score(sol: &Solution, truth: &NavState) -> Scored {
-    let pos = earth::llh_to_enu(&sol.nav.p, &truth.p);
-    let vel = sol.nav.v_n - truth.v_n;
-    // C(est) = (I − φ×) C(true) ⇒ exp(−φ×) = C(est) C(true)ᵀ.
-    let phi = -(sol.nav.q_nb * truth.q_nb.inverse()).scaled_axis();
-    let (north, east) = earth::metres_per_radian(&sol.nav.p);
-    let mut t = SMatrix::<f64, 9, 20>::zeros();
-    t[(0, DP + 1)] = east;
-    t[(1, DP)] = north;
-    t[(2, DP + 2)] = 1.0;
-    for i in 0..3 {
-        t[(3 + i, DV + i)] = 1.0;
-        t[(6 + i, PHI + i)] = 1.0;
-    }
-    let p = t * sol.covariance * t.transpose();
-    let e =
-        SVector::<f64, 9>::from_iterator(pos.iter().chain(vel.iter()).chain(phi.iter()).cloned());
-    let nees = e.dot(&(p.try_inverse().unwrap() * e));
-    let (r1, p1, y1) = sol.nav.q_nb.euler_angles();
-    let (r0, p0, y0) = truth.q_nb.euler_angles();
-    let wrap = |a: f64| {
-        (a + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI) - std::f64::consts::PI
-    };
-    Scored {
-        pos,
-        vel,
-        roll_pitch_yaw_err: Vector3::new(wrap(r1 - r0), wrap(p1 - p0), wrap(y1 - y0)),
-        nees,
     }
 }
 
@@ -245,7 +203,13 @@ fn run_drive(config: Config) -> Metrics {
             // Score once per second, at the solution right after the update.
             if let Some(state) = engine.state() {
                 if t_init.is_some_and(|t0: f64| t - t0 >= SETTLING_S) {
-                    scored.push(score(&state.solution(), &truth.nav));
+                    let reference = eval::TruthSample {
+                        t_s: t,
+                        p: truth.nav.p,
+                        v_n: Some(truth.nav.v_n),
+                        q_nb: Some(truth.nav.q_nb),
+                    };
+                    scored.push(eval::solution_error(&state.solution(), &reference));
                 }
             }
         }
@@ -266,15 +230,18 @@ fn run_drive(config: Config) -> Metrics {
     let (lo, hi) = (chi2.inverse_cdf(0.025), chi2.inverse_cdf(0.975));
     let n = scored.len() as f64;
     Metrics {
-        horizontal_m: rms(scored.iter().map(|s| s.pos.xy().norm())),
-        vertical_m: rms(scored.iter().map(|s| s.pos[2])),
-        velocity_mps: rms(scored.iter().map(|s| s.vel.norm())),
-        roll_pitch_deg: rms(scored
-            .iter()
-            .flat_map(|s| [s.roll_pitch_yaw_err[0], s.roll_pitch_yaw_err[1]]))
+        horizontal_m: rms(scored.iter().map(|s| s.position_enu_m.xy().norm())),
+        vertical_m: rms(scored.iter().map(|s| s.position_enu_m[2])),
+        velocity_mps: rms(scored.iter().map(|s| s.velocity_enu_mps.unwrap().norm())),
+        roll_pitch_deg: rms(scored.iter().flat_map(|s| {
+            [
+                s.attitude_rpy_rad.unwrap()[0],
+                s.attitude_rpy_rad.unwrap()[1],
+            ]
+        }))
         .to_degrees()
             * std::f64::consts::SQRT_2,
-        yaw_deg: rms(scored.iter().map(|s| s.roll_pitch_yaw_err[2])).to_degrees(),
+        yaw_deg: rms(scored.iter().map(|s| s.attitude_rpy_rad.unwrap()[2])).to_degrees(),
         nees_inside: scored
             .iter()
             .filter(|s| s.nees >= lo && s.nees <= hi)
