@@ -71,7 +71,7 @@ impl ArModel {
         let mut current = coefficients.to_vec();
         for j in (1..=order).rev() {
             let k = current.last().copied().unwrap_or(0.0);
-            if !(k.abs() < 1.0) {
+            if k.is_nan() || k.abs() >= 1.0 {
                 return Err(ArProcessError::NotStationary {
                     order: j,
                     reflection: k,

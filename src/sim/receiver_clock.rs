@@ -120,7 +120,7 @@ impl ReceiverClock {
 
     /// Moves the clock `dt_s` ≥ 0 seconds on (exact discretisation, see the module notes).
     pub fn advance(&mut self, dt_s: f64, rng: &mut ChaCha8Rng) {
-        if !(dt_s > 0.0) {
+        if dt_s.is_nan() || dt_s <= 0.0 {
             return;
         }
         let q11 = self.bias_density * dt_s + self.drift_density * dt_s.powi(3) / 3.0;

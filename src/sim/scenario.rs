@@ -38,6 +38,11 @@ use crate::sim::{ImuErrorModel, ImuErrorModelError, Trajectory, TrajectoryError,
 /// so that a noise-free scenario still has finite weights.
 const FIX_MIN_SIGMA_M: f64 = 0.01;
 const FIX_MIN_SIGMA_MPS: f64 = 0.001;
+/// Largest PDOP of a fix. Choice: receivers suppress fixes of poor geometry with a PDOP
+/// mask (commonly 10–25); 10 keeps every fix's position σ within ten range σ. Without it a
+/// four-satellite urban epoch with two satellites nearly in line gives "fixes" tens of
+/// kilometres off.
+const MAX_FIX_PDOP: f64 = 10.0;
 /// Slack (in periods) when counting the samples of a stream, so that 400 s at 100 Hz gives
 /// 40 001 samples despite rounding.
 const COUNT_SLACK_PERIODS: f64 = 1e-6;
@@ -113,7 +118,8 @@ pub enum SimEvent {
         /// The truth behind the epoch.
         truth: GnssTruth,
     },
-    /// A receiver-like fix of the antenna: the single-point solution of the same epoch.
+    /// A receiver-like fix of the antenna: the single-point solution of the same epoch
+    /// (none when it fails or its PDOP exceeds 10).
     Fix(GnssFix),
 }
 
@@ -358,6 +364,7 @@ impl Scenario {
         epoch.satellites = satellites;
         let fix = solve_spp(&epoch, &self.spp)
             .ok()
+            .filter(|sol| sol.dop.pdop <= MAX_FIX_PDOP)
             .map(|sol| fix_from_solution(t_s, &sol));
         out.push_back(SimEvent::Gnss {
             truth_sigmas: sat_truths
