@@ -137,3 +137,46 @@ impl ReceiverClock {
         self.state.drift_mps += l21 * xi1 + l22 * xi2;
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand_chacha::rand_core::SeedableRng;
+
+    #[test]
+    fn densities_of_the_default_tcxo() {
+        let spec = ReceiverClockSpec::default();
+        // c² = 8.987 551 787 368 176 4e16 m²/s².
+        assert!((spec.bias_noise_density_m2_per_s() - 8.987_551_787e-3).abs() < 1e-12);
+        let s_d = 2.0 * std::f64::consts::PI.powi(2) * 8.987_551_787_368_176e16 * 2e-20;
+        assert!((spec.drift_noise_density_m2_per_s3() - s_d).abs() < 1e-15);
+        assert!(spec.invalid_field().is_none());
+        let bad = ReceiverClockSpec {
+            white_frequency_h0_s: -1.0,
+            ..spec
+        };
+        assert_eq!(
+            bad.invalid_field().map(|f| f.0),
+            Some("white_frequency_h0_s")
+        );
+    }
+
+    #[test]
+    fn a_noise_free_clock_drifts_linearly() {
+        let spec = ReceiverClockSpec {
+            white_frequency_h0_s: 0.0,
+            random_walk_frequency_h_minus2_per_s: 0.0,
+            ..ReceiverClockSpec::default()
+        };
+        let mut clock = ReceiverClock::new(&spec);
+        let mut rng = ChaCha8Rng::seed_from_u64(1);
+        for _ in 0..10 {
+            clock.advance(0.5, &mut rng);
+        }
+        clock.advance(0.0, &mut rng);
+        clock.advance(f64::NAN, &mut rng);
+        let s = clock.state();
+        assert_eq!(s.drift_mps, 45.0);
+        assert!((s.bias_m - (3000.0 + 45.0 * 5.0)).abs() < 1e-9);
+    }
+}

@@ -106,9 +106,9 @@ pub struct SatContext<'a> {
     pub azimuth_rad: f64,
     /// Vehicle course over ground, clockwise from north (rad), for the street geometry.
     pub course_rad: f64,
-    /// The environment and its segment index (None outside every segment).
+    /// The environment in force.
     pub environment: &'a Environment,
-    /// Its segment index.
+    /// Its segment index in the spec (None: open sky outside every segment).
     pub segment: Option<usize>,
 }
 
@@ -327,5 +327,89 @@ impl SatErrorGenerator {
         } else {
             0.0
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gnss::Constellation;
+    use crate::sim::environment::UrbanCanyonSpec;
+    use rand::Rng;
+
+    fn sat(prn: u16) -> SatId {
+        SatId {
+            constellation: Constellation::Gps,
+            prn,
+        }
+    }
+
+    fn ctx(environment: &Environment, elevation_deg: f64, azimuth_deg: f64) -> SatContext<'_> {
+        SatContext {
+            sat: sat(3),
+            epoch_index: 12,
+            elevation_rad: elevation_deg.to_radians(),
+            azimuth_rad: azimuth_deg.to_radians(),
+            course_rad: 0.0,
+            environment,
+            segment: Some(0),
+        }
+    }
+
+    #[test]
+    fn streams_depend_only_on_seed_purpose_satellite_and_slot() {
+        let draw = |seed, purpose, s, slot| stream_rng(seed, purpose, s, slot).next_u64();
+        let a = draw(1, StreamPurpose::Thermal, Some(sat(3)), 12);
+        assert_eq!(a, draw(1, StreamPurpose::Thermal, Some(sat(3)), 12));
+        assert_ne!(a, draw(2, StreamPurpose::Thermal, Some(sat(3)), 12));
+        assert_ne!(a, draw(1, StreamPurpose::Events, Some(sat(3)), 12));
+        assert_ne!(a, draw(1, StreamPurpose::Thermal, Some(sat(4)), 12));
+        assert_ne!(a, draw(1, StreamPurpose::Thermal, Some(sat(3)), 13));
+        assert_ne!(
+            stream_id(StreamPurpose::Imu, None),
+            stream_id(StreamPurpose::ReceiverClock, None)
+        );
+    }
+
+    #[test]
+    fn open_sky_sigma_follows_the_cn0() {
+        let thermal = ThermalNoiseSpec::default();
+        let mut g = SatErrorGenerator::new(5, thermal.clone(), vec![None]);
+        let open = Environment::OpenSky;
+        let zenith = g.draw(&ctx(&open, 90.0, 0.0)).unwrap();
+        assert!((zenith.cn0_dbhz - 50.0).abs() < 1e-12);
+        assert!((zenith.pseudorange_sigma_m - 0.5).abs() < 1e-12);
+        assert!((zenith.pseudorange_rate_sigma_mps - 0.05).abs() < 1e-12);
+        // 30°: C/N0 = 35 + 7.5 = 42.5 dB-Hz, σ ratio 10^(7.5/20).
+        let mut g = SatErrorGenerator::new(5, thermal, vec![None]);
+        let low = g.draw(&ctx(&open, 30.0, 0.0)).unwrap();
+        assert!((low.cn0_dbhz - 42.5).abs() < 1e-12);
+        assert!((low.pseudorange_sigma_m - 0.5 * 10f64.powf(7.5 / 20.0)).abs() < 1e-12);
+        assert_eq!(low.nlos_bias_m, 0.0);
+        assert_eq!(low.multipath_m, 0.0);
+    }
+
+    #[test]
+    fn urban_mask_and_outage_block() {
+        let urban = Environment::UrbanCanyon(UrbanCanyonSpec {
+            cn0_loss_db: 0.0,
+            min_mask_elevation_deg: 15.0,
+            building_height_m: 15.0,
+            street_width_m: 30.0,
+            nlos_fraction: 0.0,
+            nlos_bias_min_m: 10.0,
+            nlos_bias_max_m: 50.0,
+            outlier_probability: 0.0,
+            outlier_min_m: 20.0,
+            outlier_max_m: 80.0,
+        });
+        let mut g = SatErrorGenerator::new(5, ThermalNoiseSpec::default(), vec![None]);
+        // Across the street (azimuth 90° from the course) the walls reach 45°.
+        assert!(g.draw(&ctx(&urban, 44.0, 90.0)).is_none());
+        assert!(g.draw(&ctx(&urban, 46.0, 90.0)).is_some());
+        // Along the street only the 15° floor.
+        assert!(g.draw(&ctx(&urban, 14.0, 0.0)).is_none());
+        assert!(g.draw(&ctx(&urban, 16.0, 180.0)).is_some());
+        assert!(g.draw(&ctx(&Environment::Outage, 80.0, 0.0)).is_none());
     }
 }

@@ -147,6 +147,8 @@ pub struct Scenario {
     lever_arm_b_m: Vector3<f64>,
     foliage: Vec<Option<FoliageModels>>,
     spp: SppConfig,
+    /// The IMU error model at the start, seeded from the IMU stream.
+    imu_model: ImuErrorModel,
 }
 
 impl Scenario {
@@ -154,8 +156,8 @@ impl Scenario {
     pub fn new(spec: ScenarioSpec, seed: u64) -> Result<Self, ScenarioError> {
         spec.validate()?;
         let trajectory = Trajectory::new(&spec.trajectory)?;
-        // Builds (and so validates) the IMU model once; events() builds its own copy.
-        ImuErrorModel::new(&spec.imu.errors, spec.imu.rate_hz, seed)?;
+        let imu_seed = stream_rng(seed, StreamPurpose::Imu, None, 0).next_u64();
+        let imu_model = ImuErrorModel::new(&spec.imu.errors, spec.imu.rate_hz, imu_seed)?;
         let foliage = spec
             .environments
             .iter()
@@ -193,6 +195,7 @@ impl Scenario {
             trajectory,
             foliage,
             spp,
+            imu_model,
             seed,
             spec,
         })
@@ -248,16 +251,15 @@ impl Scenario {
         self.spec.environment_at(t_s)
     }
 
-    /// The events, in time order (a fresh, identical stream on every call).
+    /// The events, in time order (a fresh, identical stream on every call). Should the
+    /// simulation fail at some epoch (which validation is meant to exclude), the stream
+    /// yields that error once and ends.
     pub fn events(&self) -> ScenarioEvents<'_> {
         let count =
             |rate_hz: f64| (self.duration_s() * rate_hz + COUNT_SLACK_PERIODS).floor() as u64 + 1;
-        let imu_seed = stream_rng(self.seed, StreamPurpose::Imu, None, 0).next_u64();
         ScenarioEvents {
             scenario: self,
-            // Validated in `new`; the error arm is unreachable but kept total.
-            imu_model: ImuErrorModel::new(&self.spec.imu.errors, self.spec.imu.rate_hz, imu_seed)
-                .ok(),
+            imu_model: self.imu_model.clone(),
             clock: ReceiverClock::new(&self.spec.gnss.receiver_clock),
             clock_rng: stream_rng(self.seed, StreamPurpose::ReceiverClock, None, 0),
             clock_t_s: 0.0,
@@ -439,7 +441,7 @@ enum Source {
 #[derive(Debug, Clone)]
 pub struct ScenarioEvents<'a> {
     scenario: &'a Scenario,
-    imu_model: Option<ImuErrorModel>,
+    imu_model: ImuErrorModel,
     clock: ReceiverClock,
     clock_rng: rand_chacha::ChaCha8Rng,
     clock_t_s: f64,
@@ -457,10 +459,7 @@ impl ScenarioEvents<'_> {
             Source::Imu => {
                 self.imu.next += 1;
                 let truth = self.scenario.truth_at(t_s)?;
-                let sample = match self.imu_model.as_mut() {
-                    Some(model) => model.corrupt(&truth.imu),
-                    None => truth.imu,
-                };
+                let sample = self.imu_model.corrupt(&truth.imu);
                 self.pending.push_back(SimEvent::Imu(sample));
             }
             Source::Truth => {
