@@ -27,3 +27,4 @@ pub mod ins;
 pub mod linalg;
 pub mod ros;
 pub mod sim;
+pub mod tools;
