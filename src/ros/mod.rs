@@ -6,7 +6,9 @@
 //! - [`cdr`]: `encode` / `decode` of a whole serialized ROS 2 payload (encapsulation
 //!   header + CDR body).
 //! - [`convert`]: wire messages -> core types (`GnssEpoch`, `ImuSample`) and ROS time.
+//! - [`bag`]: rosbag2-compatible MCAP bag writing and streaming reading.
 
+pub mod bag;
 pub mod cdr;
 pub mod convert;
 pub mod msg;
