@@ -3,9 +3,17 @@
 //! Choice: the chunks are split into groups whose time ranges overlap (sorted by start
 //! time, a group grows while the next chunk starts before the group ends). Groups are
 //! disjoint in time, so reading them one after another in log-time order gives the whole
-//! file in log-time order, and a chunk that cannot be read loses only the rest of its
-//! group: the stream reports it and goes on with the next group. In a bag written in time
-//! order every chunk is its own group, and one chunk is in memory at a time.
+//! file in log-time order with only the chunks of one group in memory at a time (one
+//! chunk, mostly, in a bag written in time order).
+//!
+//! A chunk that cannot be read (I/O error, CRC mismatch, bad record) is reported, and the
+//! group is read on without it. Math note: the MCAP library loads chunks in order of
+//! start time and loads chunk F before yielding any message later than F's start time,
+//! so when F fails every message yielded so far is at or before `start(F)` and none of
+//! the other chunks' messages after `start(F)` has been yielded. The group is resumed
+//! from `start(F)` without F, skipping the messages at exactly `start(F)` already yielded
+//! (the resumed reader yields those first, in the same order, since the chunks holding
+//! them are loaded before any chunk starting at `start(F)`).
 
 use std::collections::{HashMap, VecDeque};
 use std::fs::File;
@@ -22,6 +30,11 @@ use mcap::Summary;
 use super::error::BagError;
 use super::reader::{channel_infos, BagMessage, ChannelInfo};
 
+/// Choice: a chunk is trusted to decompress to at most 64 times the file length (zstd on
+/// ROS messages reaches about 10); a corrupt index claiming more gives an error instead
+/// of a huge allocation.
+const MAX_COMPRESSION_RATIO: u64 = 64;
+
 /// Length of a record's opcode and length prefix.
 const RECORD_PREFIX_LEN: usize = 9;
 
@@ -29,8 +42,51 @@ const RECORD_PREFIX_LEN: usize = 9;
 struct GroupReader {
     /// The MCAP library's indexed reader over the group.
     reader: IndexedReader,
-    /// The group's chunk indexes.
+    /// The group's chunk indexes (without those that failed).
     chunks: Vec<ChunkIndex>,
+    /// After resuming at a failed chunk: messages at this log time still to skip.
+    skip: Option<(u64, usize)>,
+}
+
+impl GroupReader {
+    /// A log-time reader over `chunks` from `start_ns` on, skipping the first `skip`
+    /// messages at exactly `start_ns`.
+    fn new(
+        chunks: Vec<ChunkIndex>,
+        start_ns: Option<u64>,
+        skip: usize,
+        record_length_limit: usize,
+    ) -> Result<Self, mcap::McapError> {
+        let summary = Summary {
+            chunk_indexes: chunks.clone(),
+            ..Summary::default()
+        };
+        let mut options = IndexedReaderOptions::new().with_order(ReadOrder::LogTime);
+        if let Some(start_ns) = start_ns {
+            options = options.starting_at(start_ns);
+        }
+        options.record_length_limit = Some(record_length_limit);
+        let reader = IndexedReader::new_with_options(&summary, options)?;
+        Ok(Self {
+            reader,
+            chunks,
+            skip: start_ns.map(|start_ns| (start_ns, skip)),
+        })
+    }
+
+    /// True when the message at `log_time_ns` was already yielded before a resume.
+    fn skips(&mut self, log_time_ns: u64) -> bool {
+        match &mut self.skip {
+            Some((time, count)) if *time == log_time_ns && *count > 0 => {
+                *count -= 1;
+                true
+            }
+            _ => {
+                self.skip = None;
+                false
+            }
+        }
+    }
 }
 
 /// What one step of the group reader asks for.
@@ -61,6 +117,10 @@ pub(crate) struct IndexedStream {
     current: Option<GroupReader>,
     /// Buffer of the chunk record being loaded.
     record: Vec<u8>,
+    /// Largest chunk (compressed or not) accepted, in bytes.
+    record_length_limit: usize,
+    /// Log time of the last message yielded, and how many were yielded at that time.
+    last_yielded: Option<(u64, usize)>,
 }
 
 impl IndexedStream {
@@ -75,6 +135,9 @@ impl IndexedStream {
             groups: overlap_groups(&summary.chunk_indexes),
             current: None,
             record: Vec::new(),
+            record_length_limit: usize::try_from(file_len.saturating_mul(MAX_COMPRESSION_RATIO))
+                .unwrap_or(usize::MAX),
+            last_yielded: None,
         }
     }
 
@@ -83,13 +146,8 @@ impl IndexedStream {
         loop {
             if self.current.is_none() {
                 let chunks = self.groups.pop_front()?;
-                let summary = Summary {
-                    chunk_indexes: chunks.clone(),
-                    ..Summary::default()
-                };
-                let options = IndexedReaderOptions::new().with_order(ReadOrder::LogTime);
-                match IndexedReader::new_with_options(&summary, options) {
-                    Ok(reader) => self.current = Some(GroupReader { reader, chunks }),
+                match GroupReader::new(chunks, None, 0, self.record_length_limit) {
+                    Ok(group) => self.current = Some(group),
                     Err(source) => {
                         return Some(Err(BagError::mcap(&self.path, "indexing chunks", source)))
                     }
@@ -117,38 +175,82 @@ impl IndexedStream {
                     return Some(Err(error));
                 }
                 Step::Load { offset, length } => {
-                    let loaded = load_chunk(
-                        &self.path,
-                        &mut self.file,
-                        self.file_len,
-                        &mut self.record,
-                        &current.chunks,
-                        offset,
-                        length,
-                    );
-                    let inserted = loaded.and_then(|range| {
-                        let data = self.record.get(range).unwrap_or_default();
-                        current
-                            .reader
-                            .insert_chunk_record_data(offset, data)
-                            .map_err(|source| {
-                                BagError::mcap(
-                                    &self.path,
-                                    format!("reading the chunk with data at byte {offset}"),
-                                    source,
-                                )
-                            })
-                    });
-                    if let Err(error) = inserted {
-                        self.current = None;
+                    if let Err(error) = self.load(offset, length) {
+                        self.resume_without(offset);
                         return Some(Err(error));
                     }
                 }
                 Step::Message(channel_id, log_time_ns, data) => {
+                    if current.skips(log_time_ns) {
+                        continue;
+                    }
+                    self.last_yielded = match self.last_yielded {
+                        Some((time, count)) if time == log_time_ns => Some((time, count + 1)),
+                        _ => Some((log_time_ns, 1)),
+                    };
                     return Some(self.message(channel_id, log_time_ns, data));
                 }
             }
         }
+    }
+
+    /// Loads the chunk whose compressed data starts at `offset` into the group reader.
+    fn load(&mut self, offset: u64, length: usize) -> Result<(), BagError> {
+        let Some(current) = self.current.as_mut() else {
+            return Ok(());
+        };
+        let range = load_chunk(
+            &self.path,
+            &mut self.file,
+            self.file_len,
+            &mut self.record,
+            &current.chunks,
+            offset,
+            length,
+        )?;
+        let data = self.record.get(range).unwrap_or_default();
+        current
+            .reader
+            .insert_chunk_record_data(offset, data)
+            .map_err(|source| {
+                BagError::mcap(
+                    &self.path,
+                    format!("reading the chunk with data at byte {offset}"),
+                    source,
+                )
+            })
+    }
+
+    /// Restarts the current group without the chunk whose data starts at `offset`, from
+    /// that chunk's start time (see the module doc).
+    fn resume_without(&mut self, offset: u64) {
+        let Some(current) = self.current.take() else {
+            return;
+        };
+        let (failed, remaining): (Vec<ChunkIndex>, Vec<ChunkIndex>) = current
+            .chunks
+            .into_iter()
+            .partition(|chunk| chunk.compressed_data_offset().ok() == Some(offset));
+        let Some(failed) = failed.first() else {
+            return;
+        };
+        if remaining.is_empty() {
+            return;
+        }
+        let start_ns = failed.message_start_time;
+        let already_yielded = match self.last_yielded {
+            Some((time, count)) if time == start_ns => count,
+            _ => 0,
+        };
+        // A reader over chunks that were valid a moment ago cannot fail to build; if it
+        // did, the group is dropped (its first chunk's error was already reported).
+        self.current = GroupReader::new(
+            remaining,
+            Some(start_ns),
+            already_yielded,
+            self.record_length_limit,
+        )
+        .ok();
     }
 
     /// A [`BagMessage`] on channel `channel_id`.

@@ -12,6 +12,18 @@ use mcap::sans_io::LinearReaderOptions;
 use super::error::BagError;
 use super::reader::{BagMessage, CDR_ENCODING};
 
+/// The MCAP library's front-to-back reader over `file`, checking chunk CRCs.
+pub(crate) fn message_reader(file: File) -> MessageReader<BufReader<File>> {
+    // Choice: no record can be longer than the file. The limit turns a garbage record
+    // length into an error instead of a huge allocation (which aborts the process).
+    let file_len = file.metadata().map(|metadata| metadata.len()).unwrap_or(0);
+    let record_length_limit = usize::try_from(file_len).unwrap_or(usize::MAX);
+    let options = LinearReaderOptions::default()
+        .with_validate_chunk_crcs(true)
+        .with_record_length_limit(record_length_limit);
+    MessageReader::new_with_options(BufReader::new(file), options)
+}
+
 /// Streams the messages of a file in file order.
 pub(crate) struct LinearStream {
     /// The file.
@@ -25,10 +37,9 @@ pub(crate) struct LinearStream {
 impl LinearStream {
     /// A stream over `file`.
     pub(crate) fn new(path: PathBuf, file: File) -> Self {
-        let options = LinearReaderOptions::default().with_validate_chunk_crcs(true);
         Self {
             path,
-            reader: MessageReader::new_with_options(BufReader::new(file), options),
+            reader: message_reader(file),
             yielded: 0,
         }
     }

@@ -9,7 +9,7 @@
 
 use std::collections::HashMap;
 use std::fs::File;
-use std::io::{BufReader, Read, Seek};
+use std::io::{Read, Seek};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -18,7 +18,7 @@ use mcap::Summary;
 
 use super::error::BagError;
 use super::indexed::IndexedStream;
-use super::linear::LinearStream;
+use super::linear::{message_reader, LinearStream};
 
 /// One message of a bag, still serialized: decode it with [`crate::ros::cdr::decode`].
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -228,8 +228,11 @@ fn check_magic(path: &Path, file: &mut File) -> Result<(), BagError> {
 /// truncated or damaged file, which is then read front to back).
 fn read_summary(path: &Path, file: &mut File) -> Option<Summary> {
     let len = file.metadata().ok()?.len();
-    let mut reader =
-        SummaryReader::new_with_options(SummaryReaderOptions::default().with_file_size(len));
+    // No record can be longer than the file: a garbage length is an error, not an allocation.
+    let options = SummaryReaderOptions::default()
+        .with_file_size(len)
+        .with_record_length_limit(usize::try_from(len).unwrap_or(usize::MAX));
+    let mut reader = SummaryReader::new_with_options(options);
     while let Some(event) = reader.next_event() {
         match event {
             Ok(SummaryReadEvent::ReadRequest(need)) => {
@@ -323,7 +326,7 @@ fn indexed_topics(summary: &Summary) -> Vec<TopicInfo> {
 /// their channels appear; counts are of the messages readable.
 fn linear_topics(path: &Path) -> Result<Vec<TopicInfo>, BagError> {
     let file = open_file(path)?;
-    let mut reader = mcap::io::MessageReader::new(BufReader::new(file));
+    let mut reader = message_reader(file);
     let mut topics: Vec<TopicInfo> = Vec::new();
     let mut index_by_channel: HashMap<u16, usize> = HashMap::new();
     for message in reader.by_ref() {
