@@ -7,7 +7,9 @@
 //!   header + CDR body).
 //! - [`convert`]: wire messages -> core types (`GnssEpoch`, `ImuSample`) and ROS time.
 //! - [`outbound`]: engine outputs -> Odometry, NavSatFix, NoiseEstimates.
+//! - [`bag`]: rosbag2-compatible MCAP bag writing and streaming reading.
 
+pub mod bag;
 pub mod cdr;
 pub mod convert;
 pub mod msg;
