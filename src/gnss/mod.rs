@@ -5,6 +5,7 @@ pub mod atmosphere;
 pub mod ephemeris;
 pub mod geometry;
 mod observation;
+pub mod rinex_nav;
 pub mod spp;
 pub mod ubx;
 
