@@ -20,7 +20,7 @@ const SHORT_RECORD_LINES: usize = 3;
 const FIELD_WIDTH: usize = 19;
 /// Days from 0000-03-01 (proleptic Gregorian) to 1980-01-06, in [`days_from_civil`]'s
 /// count.
-const GPS_EPOCH_DAYS: i64 = 723_186;
+const GPS_EPOCH_DAYS: i64 = 723_125;
 
 /// Errors of the RINEX navigation reader, with the 1-based line number.
 #[derive(Debug, Error, Clone, PartialEq, Eq)]

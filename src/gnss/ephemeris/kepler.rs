@@ -358,3 +358,210 @@ fn geo_to_ecef(
     let tilted_pos = rx * pos_gk;
     (rz * tilted_pos, rz_dot * tilted_pos + rz * (rx * vel_gk))
 }
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    /// G32 of the walk_0827 navigation file (RINEX values), toe 2381/410400.
+    pub(crate) fn g32() -> KeplerianEphemeris {
+        KeplerianEphemeris {
+            sat: SatId {
+                constellation: Constellation::Gps,
+                prn: 32,
+            },
+            source: NavSource::GpsLnav,
+            toe: GpsTime::new(2381, 410_400.0),
+            toc: GpsTime::new(2381, 410_400.0),
+            sqrt_a_sqrt_m: 0.515364527702e4,
+            eccentricity: 0.863428541925e-2,
+            inclination_rad: 0.965781992719,
+            inclination_rate_rad_s: 0.971469037013e-10,
+            raan_rad: 0.224492021439e1,
+            raan_rate_rad_s: -0.795997442203e-8,
+            arg_perigee_rad: -0.206125929204e1,
+            mean_anomaly_rad: 0.273480178381e1,
+            mean_motion_diff_rad_s: 0.471448209139e-8,
+            cuc_rad: -0.897794961929e-6,
+            cus_rad: 0.561214983463e-5,
+            crc_m: 0.271718750000e3,
+            crs_m: -0.167812500000e2,
+            cic_rad: 0.111758708954e-7,
+            cis_rad: -0.162050127983e-6,
+            af0_s: -0.344484578818e-3,
+            af1_s_s: 0.131876731757e-10,
+            af2_s_s2: 0.0,
+            group_delay: GroupDelay::Gps {
+                tgd_s: 0.931322574615e-9,
+            },
+            issue_of_data: 83,
+            health: 0,
+            validity_s: 7_200.0,
+        }
+    }
+
+    #[test]
+    fn orbit_radius_period_and_relativistic_term_are_those_of_a_gps_orbit() {
+        let eph = g32();
+        let a = eph.sqrt_a_sqrt_m.powi(2);
+        let e = eph.eccentricity;
+        // IS-GPS-200: semi-major axis ≈ 26 560 km, period half a sidereal day (≈ 43 082 s).
+        let period_s = 2.0 * std::f64::consts::PI * (a.powi(3) / GPS_CONSTANTS.gm_m3_s2).sqrt();
+        assert!((period_s - 43_082.0).abs() < 20.0, "{period_s}");
+        let f = -4.442_807_633e-10; // F of IS-GPS-200 20.3.3.3.3.1 (s/√m)
+        let bound_s = (f * e * eph.sqrt_a_sqrt_m).abs();
+        let mut max_rel = 0.0f64;
+        for k in 0..=48 {
+            let t = eph.toe.add_seconds(-7_200.0 + 300.0 * f64::from(k));
+            let s = eph.state_at(&t).unwrap();
+            let r = s.pos_ecef_m.norm();
+            // Radius within the ellipse's bounds (± harmonic corrections of < 1 km).
+            assert!(r > a * (1.0 - e) - 1e3 && r < a * (1.0 + e) + 1e3, "{r}");
+            assert!(s.relativistic_s.abs() <= bound_s * (1.0 + 1e-9));
+            max_rel = max_rel.max(s.relativistic_s.abs());
+            // ECEF speed of a GPS satellite: about 3.9 km/s ± the earth-rotation term.
+            let v = s.vel_ecef_mps.norm();
+            assert!(v > 2_500.0 && v < 4_200.0, "{v}");
+        }
+        // Over two hours E sweeps ~60°: the term reaches a good part of its bound (≈ 19.8 ns).
+        assert!((bound_s - 19.77e-9).abs() < 0.05e-9, "{bound_s}");
+        assert!(max_rel > 0.5 * bound_s);
+    }
+
+    fn central_difference(eph: &KeplerianEphemeris, t: &GpsTime) -> (Vector3<f64>, f64) {
+        let h = 0.5;
+        let p = eph.state_at(&t.add_seconds(h)).unwrap();
+        let m = eph.state_at(&t.add_seconds(-h)).unwrap();
+        (
+            (p.pos_ecef_m - m.pos_ecef_m) / (2.0 * h),
+            (p.clock_bias_s - m.clock_bias_s) / (2.0 * h),
+        )
+    }
+
+    #[test]
+    fn velocity_and_clock_drift_equal_the_central_difference() {
+        let mut eph = g32();
+        eph.af2_s_s2 = 1e-18;
+        for k in 0..10 {
+            let t = eph.toe.add_seconds(-7_000.0 + 1_500.0 * f64::from(k));
+            let s = eph.state_at(&t).unwrap();
+            let (v, drift) = central_difference(&eph, &t);
+            // Central difference error ~ h² |r⃛| / 6 ≈ 1e-4 m/s at h = 0.5 s.
+            assert!(
+                (s.vel_ecef_mps - v).norm() < 1e-3,
+                "{} vs {}",
+                s.vel_ecef_mps,
+                v
+            );
+            assert!((s.clock_drift_s_s - drift).abs() < 1e-15);
+        }
+    }
+
+    /// A BeiDou GEO whose broadcast elements describe a satellite fixed over longitude
+    /// 110.5° E in CGCS2000: circular orbit at the geostationary radius, inclined 5° in the
+    /// ICD's tilted reference frame, node at Ω_k = π (see the test below).
+    fn geo() -> KeplerianEphemeris {
+        let w = BEIDOU_CONSTANTS.earth_rate_rad_s;
+        let a = (BEIDOU_CONSTANTS.gm_m3_s2 / (w * w)).cbrt();
+        let toe = GpsTime::from_bdt(1025, 406_800.0);
+        let mut eph = g32();
+        eph.sat = SatId {
+            constellation: Constellation::Beidou,
+            prn: 3,
+        };
+        eph.source = NavSource::BeidouD2;
+        eph.toe = toe;
+        eph.toc = toe;
+        eph.sqrt_a_sqrt_m = a.sqrt();
+        eph.eccentricity = 0.0;
+        eph.inclination_rad = 5f64.to_radians();
+        eph.inclination_rate_rad_s = 0.0;
+        // Ω_k = Ω₀ + Ω̇ t_k − Ω̇_e toe = π at toe, fixed in the tilted inertial frame.
+        eph.raan_rad = std::f64::consts::PI + w * 406_800.0;
+        eph.raan_rate_rad_s = 0.0;
+        eph.arg_perigee_rad = 0.0;
+        eph.mean_anomaly_rad = 0.0;
+        eph.mean_motion_diff_rad_s = 0.0;
+        eph.cuc_rad = 0.0;
+        eph.cus_rad = 0.0;
+        eph.crc_m = 0.0;
+        eph.crs_m = 0.0;
+        eph.cic_rad = 0.0;
+        eph.cis_rad = 0.0;
+        eph.group_delay = GroupDelay::Beidou {
+            tgd1_s: 0.0,
+            tgd2_s: 0.0,
+        };
+        eph
+    }
+
+    #[test]
+    fn beidou_geo_case_keeps_a_geostationary_satellite_fixed_over_the_equator() {
+        // Math note: in the tilted frame the orbit is r_GK = a(−cos u, −sin u cos 5°,
+        // sin u sin 5°) (node at Ω = π); R_X(−5°) turns it into a(−cos u, −sin u, 0), an
+        // equatorial circle traversed at ω_e, which R_Z(ω_e t_k) freezes in ECEF. So the
+        // ICD algorithm must give a fixed point on the equator; the GPS-like algorithm on
+        // the same elements gives a 5°-inclined orbit instead.
+        let eph = geo();
+        assert!(eph.is_beidou_geo());
+        let start = eph.state_at(&eph.toe).unwrap();
+        for k in 0..=24 {
+            let t = eph.toe.add_seconds(-3_600.0 + 300.0 * f64::from(k));
+            let s = eph.state_at(&t).unwrap();
+            assert!(
+                (s.pos_ecef_m - start.pos_ecef_m).norm() < 1e-3,
+                "{}",
+                s.pos_ecef_m
+            );
+            assert!(s.pos_ecef_m[2].abs() < 1e-3);
+            assert!(s.vel_ecef_mps.norm() < 1e-6, "{}", s.vel_ecef_mps);
+            let (v, _) = central_difference(&eph, &t);
+            assert!((s.vel_ecef_mps - v).norm() < 1e-6);
+        }
+        // The same elements as a MEO (GPS-like algorithm) swing ±5° in latitude.
+        let mut meo = eph;
+        meo.sat.prn = 30;
+        let max_lat_deg = (0..=24)
+            .map(|k| {
+                let t = meo.toe.add_seconds(-43_200.0 + 3_600.0 * f64::from(k));
+                let p = meo.state_at(&t).unwrap().pos_ecef_m;
+                (p[2] / p.norm()).asin().to_degrees().abs()
+            })
+            .fold(0.0, f64::max);
+        assert!(max_lat_deg > 4.0, "{max_lat_deg}");
+    }
+
+    #[test]
+    fn geo_velocity_equals_central_difference_for_a_general_orbit() {
+        let mut eph = geo();
+        eph.eccentricity = 0.001;
+        eph.inclination_rad = 0.1;
+        eph.inclination_rate_rad_s = 1e-10;
+        eph.raan_rate_rad_s = -1e-9;
+        eph.cus_rad = 1e-5;
+        eph.crc_m = 300.0;
+        eph.cis_rad = 1e-7;
+        for k in 0..8 {
+            let t = eph.toe.add_seconds(-3_000.0 + 900.0 * f64::from(k));
+            let s = eph.state_at(&t).unwrap();
+            let (v, _) = central_difference(&eph, &t);
+            assert!(
+                (s.vel_ecef_mps - v).norm() < 1e-3,
+                "{} vs {}",
+                s.vel_ecef_mps,
+                v
+            );
+        }
+    }
+
+    #[test]
+    fn invalid_elements_give_none() {
+        let mut eph = g32();
+        eph.eccentricity = 1.2;
+        assert!(eph.state_at(&eph.toe).is_none());
+        let mut eph = g32();
+        eph.crs_m = f64::NAN;
+        assert!(eph.state_at(&eph.toe).is_none());
+        assert!(g32().state_at(&GpsTime::new(2381, f64::INFINITY)).is_none());
+    }
+}

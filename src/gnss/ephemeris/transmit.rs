@@ -119,3 +119,38 @@ pub fn fill_satellite_fields(
     obs.sat_clock_drift_s_s = tx.state.clock_drift_s_s;
     Ok(tx)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gnss::ephemeris::GroupDelay;
+
+    fn g32() -> KeplerianEphemeris {
+        super::super::kepler::tests::g32()
+    }
+
+    #[test]
+    fn transmission_time_satisfies_the_light_time_equation() {
+        let eph = g32();
+        let t_rx = GpsTime::new(2381, 408_660.0);
+        let pseudorange_m = 22_000_000.0;
+        let tx = state_at_transmission(&eph, Signal::GpsL1Ca, &t_rx, pseudorange_m).unwrap();
+        // t_tx = t_rx − ρ/c − (clock − TGD), to the resolution of a seconds-of-week f64
+        // (≈ 1.2·10⁻¹⁰ s near 4·10⁵ s, i.e. < 1 µm of satellite motion).
+        let expected = t_rx.seconds_since(&tx.t_tx) - pseudorange_m / SPEED_OF_LIGHT_M_S;
+        assert!((expected - tx.clock_bias_s).abs() < 3e-10);
+        let GroupDelay::Gps { tgd_s } = eph.group_delay else {
+            unreachable!()
+        };
+        assert_eq!(tx.group_delay_s, tgd_s);
+        assert!((tx.clock_bias_s - (tx.state.clock_bias_s - tgd_s)).abs() < 1e-18);
+        assert!(matches!(
+            state_at_transmission(&eph, Signal::GalileoE1, &t_rx, pseudorange_m),
+            Err(EphemerisError::NoGroupDelay { .. })
+        ));
+        assert!(matches!(
+            state_at_transmission(&eph, Signal::GpsL1Ca, &t_rx, f64::NAN),
+            Err(EphemerisError::NonFinite { .. })
+        ));
+    }
+}
