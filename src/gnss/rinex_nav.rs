@@ -191,7 +191,10 @@ fn parse_record(
             } else {
                 NavSource::BeidouD1
             },
-            GpsTime::from_bdt(week - crate::gnss::ephemeris::BDT_WEEK_OFFSET, sow),
+            GpsTime::from_bdt(
+                week.saturating_sub(crate::gnss::ephemeris::BDT_WEEK_OFFSET),
+                sow,
+            ),
             GpsTime::from_bdt(eph_week, toe_sow),
             GroupDelay::Beidou {
                 tgd1_s: gd1,

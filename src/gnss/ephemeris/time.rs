@@ -32,17 +32,21 @@ impl GpsTime {
 
     /// A BeiDou time (BDT week, seconds of BDT week) expressed in GPST.
     pub fn from_bdt(bdt_week: i32, bdt_sow_s: f64) -> Self {
-        Self::new(bdt_week + BDT_WEEK_OFFSET, bdt_sow_s - BDT_MINUS_GPST_S)
+        Self::new(
+            bdt_week.saturating_add(BDT_WEEK_OFFSET),
+            bdt_sow_s - BDT_MINUS_GPST_S,
+        )
     }
 
     /// A Galileo System Time (GST week, seconds of week) expressed in GPST.
     pub fn from_gst(gst_week: i32, gst_tow_s: f64) -> Self {
-        Self::new(gst_week + GST_WEEK_OFFSET, gst_tow_s)
+        Self::new(gst_week.saturating_add(GST_WEEK_OFFSET), gst_tow_s)
     }
 
     /// `self − other` in seconds.
     pub fn seconds_since(&self, other: &GpsTime) -> f64 {
-        f64::from(self.week - other.week) * SECONDS_PER_WEEK + (self.tow_s - other.tow_s)
+        (f64::from(self.week) - f64::from(other.week)) * SECONDS_PER_WEEK
+            + (self.tow_s - other.tow_s)
     }
 
     /// This time shifted by `dt_s` seconds.

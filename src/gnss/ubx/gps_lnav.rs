@@ -75,7 +75,7 @@ pub fn lnav_subframe(sat: SatId, words: &[u32]) -> Result<LnavSubframe, NavDataE
 pub fn nearest_gps_time(tow_s: f64, reference: &GpsTime) -> GpsTime {
     [-1, 0, 1]
         .iter()
-        .map(|dw| GpsTime::new(reference.week + dw, tow_s))
+        .map(|dw| GpsTime::new(reference.week.saturating_add(*dw), tow_s))
         .min_by(|a, b| {
             a.seconds_since(reference)
                 .abs()
