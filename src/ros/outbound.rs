@@ -1,6 +1,7 @@
-//! Engine outputs to ROS messages: nav_msgs/Odometry (REP-103/105: pose in a local ENU
+//! Core types to ROS messages: the engine's outputs as nav_msgs/Odometry (REP-103/105: pose in a local ENU
 //! frame at the datum, twist in the body frame), sensor_msgs/NavSatFix and our
-//! NoiseEstimates (the covariance-diagnostic topic).
+//! NoiseEstimates (the covariance-diagnostic topic); and simulated inputs as Imu,
+//! GnssMeasurements and NavSatFix (for writing bags).
 
 use nalgebra::{Matrix3, SMatrix};
 
@@ -9,8 +10,9 @@ use crate::engine::{EpochReport, SatRejection, Solution};
 use crate::ins::error_state::{DV, GYRO_BIAS, GYRO_GM};
 
 use super::msg::{
-    Header, NavSatFix, NavSatStatus, NoiseEstimates, Odometry, Point, Pose, PoseWithCovariance,
-    Quaternion, SatelliteNoise, Time, Twist, TwistWithCovariance, Vector3,
+    GnssMeasurements, Header, Imu, NavSatFix, NavSatStatus, NoiseEstimates, Odometry, Point, Pose,
+    PoseWithCovariance, Quaternion, SatelliteMeasurement, SatelliteNoise, Time, Twist,
+    TwistWithCovariance, Vector3,
 };
 
 fn vector3(v: &nalgebra::Vector3<f64>) -> Vector3 {
@@ -159,6 +161,93 @@ pub fn noise_estimates(report: &EpochReport, stamp: Time, frame_id: &str) -> Noi
         chi2_threshold: report.chi2_threshold,
         q_scale: report.q_scale,
         nis: report.nis,
+    }
+}
+
+/// sensor_msgs/Imu of a sample (REP-145; orientation unknown: covariance[0] = −1).
+pub fn imu(sample: &crate::ins::ImuSample, stamp: Time, frame_id: &str) -> Imu {
+    let mut orientation_covariance = [0.0; 9];
+    orientation_covariance[0] = -1.0;
+    Imu {
+        header: Header {
+            stamp,
+            frame_id: frame_id.to_owned(),
+        },
+        orientation: Quaternion::default(),
+        orientation_covariance,
+        angular_velocity: vector3(&sample.w_ib_b_rad_s),
+        angular_velocity_covariance: [0.0; 9],
+        linear_acceleration: vector3(&sample.f_ib_b_m_s2),
+        linear_acceleration_covariance: [0.0; 9],
+    }
+}
+
+/// Our GnssMeasurements message of an epoch (absent values as NaN).
+pub fn gnss_measurements(
+    epoch: &crate::gnss::GnssEpoch,
+    gps_week: u16,
+    stamp: Time,
+    frame_id: &str,
+) -> GnssMeasurements {
+    let nan = f64::NAN;
+    GnssMeasurements {
+        header: Header {
+            stamp,
+            frame_id: frame_id.to_owned(),
+        },
+        gps_week,
+        gps_time_of_week_s: epoch.gps_time_of_week_s,
+        satellites: epoch
+            .satellites
+            .iter()
+            .map(|s| SatelliteMeasurement {
+                constellation: s.sat.constellation.code(),
+                prn: s.sat.prn,
+                pseudorange_m: s.pseudorange_m,
+                pseudorange_rate_mps: s.pseudorange_rate_mps.unwrap_or(nan),
+                pseudorange_sigma_m: s.pseudorange_sigma_m.unwrap_or(nan),
+                pseudorange_rate_sigma_mps: s.pseudorange_rate_sigma_mps.unwrap_or(nan),
+                cn0_dbhz: s.cn0_dbhz.map_or(f32::NAN, |c| c as f32),
+                satellite_position_ecef_m: Point {
+                    x: s.sat_pos_ecef_m[0],
+                    y: s.sat_pos_ecef_m[1],
+                    z: s.sat_pos_ecef_m[2],
+                },
+                satellite_velocity_ecef_mps: vector3(&s.sat_vel_ecef_mps),
+                satellite_clock_bias_s: s.sat_clock_bias_s,
+                satellite_clock_drift_s_s: s.sat_clock_drift_s_s,
+                ionosphere_delay_m: s.iono_delay_m.unwrap_or(nan),
+                troposphere_delay_m: s.tropo_delay_m.unwrap_or(nan),
+            })
+            .collect(),
+        klobuchar_alpha: epoch.klobuchar.map_or([nan; 4], |k| k.alpha),
+        klobuchar_beta: epoch.klobuchar.map_or([nan; 4], |k| k.beta),
+    }
+}
+
+/// sensor_msgs/NavSatFix of a receiver fix (ENU covariance, known or the diagonal given).
+pub fn receiver_fix(fix: &crate::engine::GnssFix, stamp: Time, frame_id: &str) -> NavSatFix {
+    let (cov, kind) = match fix.position_covariance_enu_m2 {
+        Some(c) => (
+            std::array::from_fn(|k| c[(k / 3, k % 3)]),
+            NavSatFix::COVARIANCE_TYPE_KNOWN,
+        ),
+        None => ([0.0; 9], NavSatFix::COVARIANCE_TYPE_UNKNOWN),
+    };
+    NavSatFix {
+        header: Header {
+            stamp,
+            frame_id: frame_id.to_owned(),
+        },
+        status: NavSatStatus {
+            status: NavSatStatus::STATUS_FIX,
+            service: NavSatStatus::SERVICE_GPS,
+        },
+        latitude: fix.position.lat_rad.to_degrees(),
+        longitude: fix.position.lon_rad.to_degrees(),
+        altitude: fix.position.height_m,
+        position_covariance: cov,
+        position_covariance_type: kind,
     }
 }
 

@@ -2,10 +2,7 @@
 
 use serde::Serialize;
 
-use crate::config::Config;
 use crate::eval::ErrorSummary;
-
-use super::session::{Session, SessionInput, SessionReport};
 
 /// One row of a comparison.
 #[derive(Debug, Clone, Serialize)]
@@ -39,27 +36,6 @@ impl ComparisonRow {
             runtime_s,
         }
     }
-}
-
-/// Runs `config` over `inputs` (a fresh stream each call) and returns the session report
-/// and the run time of the engine (s), measured by the caller's clock `now`.
-pub fn run_one<I, C>(
-    config: Config,
-    inputs: I,
-    score_interval_s: f64,
-    mut now: C,
-) -> (SessionReport, f64)
-where
-    I: IntoIterator<Item = SessionInput>,
-    C: FnMut() -> f64,
-{
-    let start = now();
-    let mut session = Session::new(config, score_interval_s, None);
-    for input in inputs {
-        session.push(input);
-    }
-    let runtime = now() - start;
-    (session.finish(), runtime)
 }
 
 /// The comparison as an aligned text table.

@@ -1,5 +1,9 @@
 //! The offline tools behind the `gnss_ins` command (simulate, replay, compare, demo): they
 //! read and write files and drive the one engine the live node uses.
 
+pub mod bag_inputs;
+pub mod cli;
 pub mod compare;
+pub mod replay;
 pub mod session;
+pub mod simulate;

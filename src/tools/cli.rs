@@ -1,0 +1,297 @@
+//! The `gnss_ins` subcommands: argument definitions and what each one does.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use clap::{Subcommand, ValueEnum};
+
+use crate::config::{Config, FilterVariant};
+use crate::sim::{Scenario, ScenarioSpec};
+
+use super::compare::{format_csv, format_table, ComparisonRow};
+use super::replay::{self, ReplayOptions, TruthSource};
+use super::session::{Session, SessionReport};
+use super::simulate::{self, TRUTH_TOPIC};
+
+/// Scoring interval of the comparisons (s): every reference sample of a simulated bag
+/// (10 Hz).
+const SCORE_INTERVAL_S: f64 = 0.0;
+
+#[derive(Subcommand)]
+pub enum Command {
+    /// Simulate a scenario into a rosbag2 MCAP bag (deterministic from the seed).
+    Simulate {
+        /// A built-in scenario name (default, open_sky, static) or a scenario YAML file.
+        #[arg(long, default_value = "default")]
+        scenario: String,
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Stream a bag through the engine; write the solution; score it against a reference.
+    Replay {
+        bag: PathBuf,
+        /// Parameter file (ROS 2 params layout); defaults when absent.
+        #[arg(long)]
+        params: Option<PathBuf>,
+        /// Output bag with /odometry, /fix and /noise_estimates.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Output CSV of the solutions.
+        #[arg(long)]
+        csv: Option<PathBuf>,
+        /// Reference as nav_msgs/Odometry on this topic of the bag.
+        #[arg(long, conflicts_with = "truth_csv")]
+        truth_topic: Option<String>,
+        /// Reference CSV: unix time s, lat deg, lon deg, ellipsoidal height m
+        /// [, vE vN vU m/s [, roll pitch yaw deg]].
+        #[arg(long)]
+        truth_csv: Option<PathBuf>,
+    },
+    /// Run several filter variants over one bag and tabulate their errors.
+    Compare {
+        bag: PathBuf,
+        /// Comma-separated variants (e.g. ekf,ermakf); all when absent.
+        #[arg(long, value_delimiter = ',')]
+        filters: Vec<String>,
+        /// Folder of parameter files named <variant>.yaml (else the defaults).
+        #[arg(long)]
+        params_dir: Option<PathBuf>,
+        #[arg(long, value_enum, default_value_t = Format::Table)]
+        format: Format,
+    },
+    /// Simulate the default scenario into a temporary folder and compare every variant.
+    Demo {
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum Format {
+    Table,
+    Json,
+    Csv,
+}
+
+/// Runs one subcommand.
+pub fn run(command: Command) -> Result<(), String> {
+    match command {
+        Command::Simulate {
+            scenario,
+            seed,
+            out,
+        } => {
+            let scenario = load_scenario(&scenario, seed)?;
+            let summary = simulate::simulate(&scenario, &out).map_err(|e| e.to_string())?;
+            eprintln!(
+                "wrote {}: {} IMU samples, {} GNSS epochs, {} fixes, {} reference samples",
+                out.display(),
+                summary.imu,
+                summary.gnss,
+                summary.fixes,
+                summary.truth
+            );
+            Ok(())
+        }
+        Command::Replay {
+            bag,
+            params,
+            out,
+            csv,
+            truth_topic,
+            truth_csv,
+        } => {
+            let config = load_config(params.as_deref())?;
+            let truth = match (truth_topic, truth_csv) {
+                (Some(t), _) => TruthSource::Topic(t),
+                (None, Some(path)) => {
+                    TruthSource::Track(replay::read_truth_csv(&path).map_err(|e| e.to_string())?)
+                }
+                (None, None) => TruthSource::None,
+            };
+            let options = ReplayOptions {
+                out_bag: out.as_deref(),
+                csv: csv.as_deref(),
+                score_interval_s: SCORE_INTERVAL_S,
+            };
+            let show = std::io::stderr().is_terminal();
+            let result = replay::replay(&bag, &config, truth, &options, |f| {
+                if show {
+                    eprint!("\r{}", progress_bar(f));
+                }
+            })
+            .map_err(|e| e.to_string())?;
+            if show {
+                eprintln!();
+            }
+            print_problems(&result.problems, &result.report);
+            println!(
+                "{} solutions, {} GNSS updates",
+                result.report.solutions, result.report.epochs
+            );
+            if let Some(s) = result.summary {
+                println!(
+                    "position RMSE E {:.3} N {:.3} U {:.3} 3D {:.3} m; velocity {:.4} m/s; \
+                     attitude roll {:.4} pitch {:.4} yaw {:.4} deg; mean NEES {:.2} ({} epochs)",
+                    s.pos_rmse_e_m,
+                    s.pos_rmse_n_m,
+                    s.pos_rmse_u_m,
+                    s.pos_rmse_3d_m,
+                    s.vel_rmse_3d_mps,
+                    s.att_rmse_roll_deg,
+                    s.att_rmse_pitch_deg,
+                    s.att_rmse_yaw_deg,
+                    s.nees_mean,
+                    s.epochs
+                );
+            }
+            if result.report.solutions == 0 {
+                return Err("no solution: nothing usable in the bag".to_owned());
+            }
+            Ok(())
+        }
+        Command::Compare {
+            bag,
+            filters,
+            params_dir,
+            format,
+        } => {
+            let rows = compare_bag(&bag, &filters, params_dir.as_deref())?;
+            print!("{}", render(&rows, format)?);
+            Ok(())
+        }
+        Command::Demo { seed } => {
+            let dir = std::env::temp_dir().join(format!("gnss_ins_demo_{}", std::process::id()));
+            std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+            let bag = dir.join("default.mcap");
+            let scenario = load_scenario("default", seed)?;
+            simulate::simulate(&scenario, &bag).map_err(|e| e.to_string())?;
+            println!(
+                "Simulated the default scenario (seed {seed}) into {}: a {:.0} s drive with \
+                 foliage over 40-120 s and dense buildings over 260-320 s.",
+                bag.display(),
+                scenario.duration_s()
+            );
+            let rows = compare_bag(&bag, &[], None)?;
+            print!("{}", format_table(&rows));
+            Ok(())
+        }
+    }
+}
+
+fn progress_bar(fraction: f64) -> String {
+    let width = 40;
+    let done = ((fraction.clamp(0.0, 1.0)) * width as f64).round() as usize;
+    format!(
+        "[{}{}] {:5.1} %",
+        "#".repeat(done),
+        " ".repeat(width - done),
+        fraction * 100.0
+    )
+}
+
+fn print_problems(problems: &super::bag_inputs::ReadProblems, report: &SessionReport) {
+    for (what, n) in &problems.undecodable {
+        eprintln!("skipped {n} undecodable messages ({what})");
+    }
+    for e in &problems.bag_errors {
+        eprintln!("bag error: {e}");
+    }
+    if !report.rejected.is_empty() {
+        let mut by_reason = std::collections::BTreeMap::new();
+        for r in &report.rejected {
+            *by_reason.entry(r.reason.name()).or_insert(0u64) += 1;
+        }
+        for (reason, n) in by_reason {
+            eprintln!("rejected {n} inputs: {reason}");
+        }
+    }
+}
+
+fn load_scenario(name_or_file: &str, seed: u64) -> Result<Scenario, String> {
+    let spec = if ScenarioSpec::builtin_names().contains(&name_or_file) {
+        ScenarioSpec::builtin(name_or_file).map_err(|e| e.to_string())?
+    } else {
+        let text = std::fs::read_to_string(name_or_file)
+            .map_err(|e| format!("scenario {name_or_file}: {e}"))?;
+        ScenarioSpec::from_yaml(&text).map_err(|e| format!("{name_or_file}: {e}"))?
+    };
+    Scenario::new(spec, seed).map_err(|e| e.to_string())
+}
+
+fn load_config(path: Option<&Path>) -> Result<Config, String> {
+    match path {
+        None => Ok(Config::default()),
+        Some(p) => {
+            let text = std::fs::read_to_string(p).map_err(|e| format!("{}: {e}", p.display()))?;
+            Config::from_yaml_str(&text, &p.display().to_string()).map_err(|e| e.to_string())
+        }
+    }
+}
+
+/// The configuration of one variant: `<dir>/<variant>.yaml` when present, else the
+/// defaults with that variant.
+fn variant_config(name: &str, params_dir: Option<&Path>) -> Result<Config, String> {
+    if let Some(dir) = params_dir {
+        let path = dir.join(format!("{name}.yaml"));
+        if path.exists() {
+            return load_config(Some(&path));
+        }
+    }
+    let variant = FilterVariant::ALL
+        .into_iter()
+        .find(|v| v.as_str() == name)
+        .ok_or_else(|| {
+            let known: Vec<&str> = FilterVariant::ALL.iter().map(|v| v.as_str()).collect();
+            format!("unknown filter '{name}' (known: {})", known.join(", "))
+        })?;
+    let mut config = Config::default();
+    config.filter.variant = variant;
+    Ok(config)
+}
+
+/// Runs each filter over the bag and returns one row per filter.
+fn compare_bag(
+    bag: &Path,
+    filters: &[String],
+    params_dir: Option<&Path>,
+) -> Result<Vec<ComparisonRow>, String> {
+    let names: Vec<String> = if filters.is_empty() {
+        FilterVariant::ALL
+            .iter()
+            .map(|v| v.as_str().to_owned())
+            .collect()
+    } else {
+        filters.to_vec()
+    };
+    let mut rows = Vec::new();
+    for name in names {
+        let config = variant_config(&name, params_dir)?;
+        let inputs =
+            replay::bag_inputs(bag, Some(TRUTH_TOPIC.to_owned())).map_err(|e| e.to_string())?;
+        let start = Instant::now();
+        let mut session = Session::new(config, SCORE_INTERVAL_S, None);
+        for input in inputs {
+            session.push(input);
+        }
+        let runtime = start.elapsed().as_secs_f64();
+        let report = session.finish();
+        rows.push(ComparisonRow::new(
+            &name,
+            &report.summary(f64::NEG_INFINITY),
+            runtime,
+        ));
+    }
+    Ok(rows)
+}
+
+fn render(rows: &[ComparisonRow], format: Format) -> Result<String, String> {
+    Ok(match format {
+        Format::Table => format_table(rows),
+        Format::Csv => format_csv(rows),
+        Format::Json => serde_json::to_string_pretty(rows).map_err(|e| e.to_string())? + "\n",
+    })
+}
