@@ -445,6 +445,9 @@ impl Engine {
                         }
                     }
                     Ok(_) | Err(_) => {
+                        if let Err(e) = &result {
+                            log::warn!("update at t = {t:.3} s failed: {e}");
+                        }
                         **state = before;
                         self.counters.reject(RejectionReason::UpdateFailed, t);
                     }

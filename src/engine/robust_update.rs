@@ -21,10 +21,17 @@
 //! (section 4) concerns models whose linearization is poor, which for an error state in
 //! closed loop is the measurement side.
 //!
-//! Choice (posterior): P⁺ = P̄ − K P_xzᵀ − P_xz Kᵀ + K S Kᵀ, the Joseph-equivalent form for
-//! both bases (for the EKF, P_xz = P̄Hᵀ and S = HP̄Hᵀ + R̄ make it exactly Joseph's form),
-//! with P̄ = P⁻/α the prior the adaptive gain of eq. (19) acts on. The plain EKF without a
-//! scheme keeps [`ekf::update`] and its `filter.joseph_form` option.
+//! Choice (posterior): the IARF paper's eq. (16), P⁺ = P⁻ − K̄HP⁻ with the un-inflated P⁻,
+//! computed in Joseph's form (I − K̄H)P⁻(I − K̄H)ᵀ + K̄(αR̄)K̄ᵀ with the linearized rows H
+//! for both bases (K̄ = (P⁻/α)Hᵀ(HP⁻Hᵀ/α + R̄)⁻¹ is the optimal gain of P⁻ with the noise
+//! αR̄, so this is the covariance of the estimate; for the cubature base K̄ is the cubature
+//! gain P_xz S⁻¹ of the inflated prior). Yang's (I − K̄H)P⁻/α, which the adaptive-factor
+//! module documents as an alternative, was measured to diverge on the outlier drive of
+//! tests/iarf_engine.rs (akf_all, α down to 0.01): it multiplies the variance of every
+//! direction the fix does not observe (clock states, parts of the attitude and biases) by
+//! 1/α at each adaptive epoch, and P overflowed within 300 s on both bases. With α = 1
+//! the three forms coincide. The plain EKF without a scheme keeps [`ekf::update`] and its
+//! `filter.joseph_form` option.
 
 use nalgebra::{DMatrix, DVector};
 
@@ -38,7 +45,7 @@ use crate::config::{AdaptiveFactorKind, Config, EquivalentWeightKind, FilterVari
 use crate::filter::cubature::{cubature_measurement_update, Gaussian};
 use crate::filter::ekf::{self, FilterError};
 use crate::ins::error_state::{StateMatrix, StateVector, N};
-use crate::linalg::{symmetrize, SpdFactor};
+use crate::linalg::{symmetrize, SpdFactor, EIGEN_FLOOR};
 
 use super::filter_state::FilterState;
 
@@ -198,7 +205,10 @@ impl RobustUpdate {
         if !self.cubature && self.scheme == Scheme::Plain {
             return self.plain_ekf(state, set);
         }
-        let prior = DMatrix::from_column_slice(N, N, state.p.as_slice());
+        let mut prior = DMatrix::from_column_slice(N, N, state.p.as_slice());
+        if self.cubature {
+            prior = covariance_for_cubature(&prior)?;
+        }
         let nominal = self.moments(state, &prior, set, &set.r)?;
         let hph = symmetrize(&(&nominal.s - &set.r));
         let mut outcome = UpdateOutcome {
@@ -242,21 +252,26 @@ impl RobustUpdate {
         } else {
             None
         };
-        let (moments, prior_used) = if alpha == 1.0 && r_bar.is_none() {
-            (nominal, prior)
+        let r_bar_used = r_bar.clone();
+        let moments = if alpha == 1.0 && r_bar.is_none() {
+            nominal
         } else {
             // Math note: P⁻/α of a symmetric positive-definite P⁻ stays so (α ≥ α_floor > 0),
             // and R̄ = D R D is a congruence of R; both are symmetrised before use.
             let inflated = symmetrize(&prior) / alpha;
             let r_used = r_bar.unwrap_or_else(|| set.r.clone());
-            (self.moments(state, &inflated, set, &r_used)?, inflated)
+            self.moments(state, &inflated, set, &r_used)?
         };
         let factor = SpdFactor::new("innovation covariance", &moments.s)?;
         let gain = factor.solve(&moments.pxz.transpose()).transpose();
         let dx = &gain * &moments.innovation;
-        let k_pxz = &gain * moments.pxz.transpose();
+        // The paper's eq. (16) in Joseph's form with the linearized rows: K̄ is the optimal
+        // gain of the prior P⁻ with the noise αR̄, so the covariance of its estimate is
+        // (I − K̄H)P⁻(I − K̄H)ᵀ + K̄(αR̄)K̄ᵀ (= P⁻ − K̄HP⁻ when K̄ is exact).
+        let a = DMatrix::identity(N, N) - &gain * &set.h;
+        let r_used = r_bar_used.unwrap_or_else(|| set.r.clone()) * alpha;
         let posterior = symmetrize(
-            &(&prior_used - &k_pxz - k_pxz.transpose() + &gain * &moments.s * gain.transpose()),
+            &(&a * &prior * a.transpose() + &gain * symmetrize(&r_used) * gain.transpose()),
         );
         let nis = moments
             .innovation
@@ -341,4 +356,47 @@ impl RobustUpdate {
             pxz: u.cross_covariance,
         })
     }
+}
+
+/// The prior covariance as the cubature rule needs it: `p` itself when its Cholesky factor
+/// exists, else its nearest positive-definite neighbour on the correlation scale.
+///
+/// Choice: the 20-state error covariance has directions that the measurements never
+/// separate (the constant gyro bias and the Gauss-Markov drift, observable only as a sum;
+/// the clock states in loose coupling), whose correlation eigenvalues sit near zero and
+/// drift to about −1e-5 by rounding in the propagation and the updates (measured on the
+/// drives of tests/iarf_engine.rs). The EKF never factors P and does not notice; the
+/// cubature points need its square root. The correlation matrix C = D⁻¹PD⁻¹ is
+/// eigen-decomposed and its eigenvalues raised to [`EIGEN_FLOOR`]; the variances change by
+/// at most that relative amount plus the size of the negative eigenvalues. A matrix with a
+/// non-positive or non-finite variance is an error.
+fn covariance_for_cubature(p: &DMatrix<f64>) -> Result<DMatrix<f64>, FilterError> {
+    let p = symmetrize(p);
+    if p.clone().cholesky().is_some() {
+        return Ok(p);
+    }
+    let d = p.diagonal();
+    if let Some((index, &value)) = d
+        .iter()
+        .enumerate()
+        .find(|(_, v)| !(v.is_finite() && **v > 0.0))
+    {
+        return Err(FilterError::Linalg(
+            crate::linalg::LinalgError::NonPositiveVariance {
+                what: "prior covariance",
+                index,
+                value,
+            },
+        ));
+    }
+    let scale = d.map(f64::sqrt);
+    let n = p.nrows();
+    let c = DMatrix::from_fn(n, n, |i, j| p[(i, j)] / (scale[i] * scale[j]));
+    let eigen =
+        nalgebra::SymmetricEigen::try_new(c, f64::EPSILON, 10_000).ok_or(FilterError::NonFinite)?;
+    let values = eigen.eigenvalues.map(|v| v.max(EIGEN_FLOOR));
+    let c = &eigen.eigenvectors * DMatrix::from_diagonal(&values) * eigen.eigenvectors.transpose();
+    Ok(symmetrize(&DMatrix::from_fn(n, n, |i, j| {
+        c[(i, j)] * scale[i] * scale[j]
+    })))
 }
