@@ -96,8 +96,8 @@ pub struct RawClock {
 impl Default for RawClock {
     fn default() -> Self {
         Self {
-            bias_noise_m_per_sqrt_s: 0.5,
-            drift_noise_mps_per_sqrt_s: 0.1,
+            bias_noise_m_per_sqrt_s: 0.1,
+            drift_noise_mps_per_sqrt_s: 0.2,
             drift_correlation_time_s: 1800.0,
         }
     }

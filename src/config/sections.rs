@@ -247,9 +247,9 @@ pub struct MountingConfig {
 /// `clock.*`: receiver clock bias c·δt_u (m) and drift c·δt_ru (m/s).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ClockConfig {
-    /// White noise driving the bias (m/√s), `clock.bias_noise_m_per_sqrt_s` (default `0.5`).
+    /// White noise driving the bias (m/√s), `clock.bias_noise_m_per_sqrt_s` (default `0.1`).
     pub bias_noise_m_per_sqrt_s: f64,
-    /// White noise driving the drift (m/s/√s), `clock.drift_noise_mps_per_sqrt_s` (default `0.1`).
+    /// White noise driving the drift (m/s/√s), `clock.drift_noise_mps_per_sqrt_s` (default `0.2`).
     pub drift_noise_m_s_per_sqrt_s: f64,
     /// Drift correlation time (s), `clock.drift_correlation_time_s` (default `1800`).
     pub drift_time_s: f64,

@@ -2,8 +2,11 @@
 //! measurement models (predicted pseudo-range and rate, atmosphere, single-point solution).
 
 pub mod atmosphere;
+pub mod ephemeris;
 pub mod geometry;
 mod observation;
+pub mod rinex_nav;
 pub mod spp;
+pub mod ubx;
 
 pub use observation::{Constellation, GnssEpoch, Klobuchar, SatId, SatObservation};

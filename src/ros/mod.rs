@@ -6,7 +6,11 @@
 //! - [`cdr`]: `encode` / `decode` of a whole serialized ROS 2 payload (encapsulation
 //!   header + CDR body).
 //! - [`convert`]: wire messages -> core types (`GnssEpoch`, `ImuSample`) and ROS time.
+//! - [`outbound`]: engine outputs -> Odometry, NavSatFix, NoiseEstimates.
+//! - [`bag`]: rosbag2-compatible MCAP bag writing and streaming reading.
 
+pub mod bag;
 pub mod cdr;
 pub mod convert;
 pub mod msg;
+pub mod outbound;

@@ -1,0 +1,191 @@
+//! UBX framing: sync 0xB5 0x62, class, id, little-endian payload length, payload, and the
+//! 8-bit Fletcher checksum over class..payload. The reader resynchronizes on any garbage
+//! and never panics.
+//!
+//! Choice (resynchronization): after a bad checksum, or a header whose declared length
+//! runs past the end of the input, the search for the next sync pattern restarts one byte
+//! after the rejected sync, so a corrupt length field cannot swallow the frames behind it.
+//! A frame cut by the end of the input is counted as truncated; a frame cut in the middle
+//! of the stream (followed by other data) fails its checksum and is counted as corrupt.
+
+/// First sync byte.
+pub const SYNC_1: u8 = 0xB5;
+/// Second sync byte.
+pub const SYNC_2: u8 = 0x62;
+/// Header bytes before the payload (sync ×2, class, id, length ×2).
+pub const HEADER_LEN: usize = 6;
+/// Checksum bytes after the payload.
+pub const CHECKSUM_LEN: usize = 2;
+
+/// One checksum-verified UBX frame, borrowing its payload from the input.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct UbxFrame<'a> {
+    /// Message class.
+    pub class: u8,
+    /// Message id.
+    pub id: u8,
+    /// Payload bytes.
+    pub payload: &'a [u8],
+    /// Byte offset of the frame's first sync byte in the input.
+    pub offset: usize,
+}
+
+/// Counts of what the reader met.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct FrameStats {
+    /// Frames with a valid checksum.
+    pub frames: usize,
+    /// Frames rejected for a bad checksum.
+    pub bad_checksum: usize,
+    /// Frames whose declared length runs past the end of the input.
+    pub truncated: usize,
+    /// Bytes skipped while looking for a sync pattern.
+    pub skipped_bytes: usize,
+}
+
+/// The 8-bit Fletcher checksum (CK_A, CK_B) of `bytes`.
+pub fn checksum(bytes: &[u8]) -> (u8, u8) {
+    bytes.iter().fold((0u8, 0u8), |(a, b), &x| {
+        let a = a.wrapping_add(x);
+        (a, b.wrapping_add(a))
+    })
+}
+
+/// Encodes a UBX frame (for tests and tools): sync, header, payload, checksum. None if
+/// the payload is longer than a u16 length can state.
+pub fn encode_frame(class: u8, id: u8, payload: &[u8]) -> Option<Vec<u8>> {
+    let len = u16::try_from(payload.len()).ok()?;
+    let mut out = Vec::with_capacity(payload.len() + HEADER_LEN + CHECKSUM_LEN);
+    out.extend_from_slice(&[SYNC_1, SYNC_2, class, id]);
+    out.extend_from_slice(&len.to_le_bytes());
+    out.extend_from_slice(payload);
+    let (a, b) = checksum(out.get(2..).unwrap_or(&[]));
+    out.push(a);
+    out.push(b);
+    Some(out)
+}
+
+/// Iterator over the valid UBX frames of a byte buffer; [`FrameReader::stats`] tells what
+/// was skipped.
+#[derive(Debug, Clone)]
+pub struct FrameReader<'a> {
+    data: &'a [u8],
+    pos: usize,
+    stats: FrameStats,
+}
+
+impl<'a> FrameReader<'a> {
+    /// A reader over `data`.
+    pub fn new(data: &'a [u8]) -> Self {
+        Self {
+            data,
+            pos: 0,
+            stats: FrameStats::default(),
+        }
+    }
+
+    /// Counts so far.
+    pub fn stats(&self) -> FrameStats {
+        self.stats
+    }
+
+    /// Tries a frame at `start` (where the sync bytes are): Some(frame) if complete and
+    /// valid; None otherwise (counted).
+    fn frame_at(&mut self, start: usize) -> Option<UbxFrame<'a>> {
+        let header = self.data.get(start..start.checked_add(HEADER_LEN)?)?;
+        let (class, id) = (*header.get(2)?, *header.get(3)?);
+        let len = usize::from(u16::from_le_bytes([*header.get(4)?, *header.get(5)?]));
+        let end = start + HEADER_LEN + len + CHECKSUM_LEN;
+        let Some(frame) = self.data.get(start..end) else {
+            self.stats.truncated += 1;
+            return None;
+        };
+        let body = frame.get(2..HEADER_LEN + len)?;
+        let (a, b) = checksum(body);
+        if frame.get(HEADER_LEN + len..) != Some(&[a, b][..]) {
+            self.stats.bad_checksum += 1;
+            return None;
+        }
+        self.stats.frames += 1;
+        Some(UbxFrame {
+            class,
+            id,
+            payload: frame.get(HEADER_LEN..HEADER_LEN + len)?,
+            offset: start,
+        })
+    }
+}
+
+impl<'a> Iterator for FrameReader<'a> {
+    type Item = UbxFrame<'a>;
+
+    fn next(&mut self) -> Option<UbxFrame<'a>> {
+        loop {
+            let rest = self.data.get(self.pos..)?;
+            let Some(found) = rest
+                .windows(2)
+                .position(|w| w.first() == Some(&SYNC_1) && w.get(1) == Some(&SYNC_2))
+            else {
+                // No sync left: the remaining bytes (bar a possible lone first sync byte
+                // at the very end, also garbage) are skipped.
+                self.stats.skipped_bytes += rest.len();
+                self.pos = self.data.len();
+                return None;
+            };
+            self.stats.skipped_bytes += found;
+            let start = self.pos + found;
+            if start + HEADER_LEN > self.data.len() {
+                // A sync pattern with an incomplete header at the end of the input.
+                self.stats.truncated += 1;
+                self.pos = self.data.len();
+                return None;
+            }
+            match self.frame_at(start) {
+                Some(frame) => {
+                    self.pos = start + HEADER_LEN + frame.payload.len() + CHECKSUM_LEN;
+                    return Some(frame);
+                }
+                None => self.pos = start + 1,
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn checksum_of_a_known_frame() {
+        // UBX-CFG-RATE poll-free example from the interface description family:
+        // B5 62 06 08 06 00 E8 03 01 00 01 00 → checksum 01 39.
+        let frame = [0x06, 0x08, 0x06, 0x00, 0xE8, 0x03, 0x01, 0x00, 0x01, 0x00];
+        assert_eq!(checksum(&frame), (0x01, 0x39));
+    }
+
+    #[test]
+    fn frames_garbage_corruption_and_truncation_are_counted() {
+        let good = encode_frame(0x01, 0x07, &[1, 2, 3]).unwrap();
+        let mut bad = encode_frame(0x02, 0x15, &[9, 9]).unwrap();
+        let last = bad.len() - 1;
+        bad[last] ^= 0xFF;
+        let mut data = vec![0x00, 0x11, SYNC_1];
+        data.extend_from_slice(&good);
+        data.extend_from_slice(&bad);
+        data.extend_from_slice(&good);
+        data.extend_from_slice(&good[..5]);
+        let mut reader = FrameReader::new(&data);
+        let frames: Vec<_> = reader.by_ref().collect();
+        assert_eq!(frames.len(), 2);
+        assert_eq!(frames[0].payload, &[1, 2, 3]);
+        assert_eq!((frames[0].class, frames[0].id), (0x01, 0x07));
+        assert_eq!(frames[0].offset, 3);
+        let stats = reader.stats();
+        assert_eq!(stats.frames, 2);
+        assert_eq!(stats.bad_checksum, 1);
+        assert_eq!(stats.truncated, 1);
+        // 3 leading garbage bytes; the bad frame's bytes after its sync are re-scanned
+        // (1 byte from the re-scan start at sync+1 ... up to the next good sync).
+        assert!(stats.skipped_bytes >= 3);
+    }
+}

@@ -1,0 +1,166 @@
+//! Message definition texts (`.msg` format) of every type a bag may hold, keyed by
+//! `pkg/Type`. The standard ROS 2 Jazzy texts are written here field for field (comments
+//! left out); the package's own texts are the files of `msg/`.
+
+use crate::ros::msg::{
+    GNSS_MEASUREMENTS_MSG, NOISE_ESTIMATES_MSG, SATELLITE_MEASUREMENT_MSG, SATELLITE_NOISE_MSG,
+};
+
+/// `builtin_interfaces/Time`.
+pub const TIME_MSG: &str = "int32 sec\nuint32 nanosec\n";
+
+/// `std_msgs/Header`.
+pub const HEADER_MSG: &str = "builtin_interfaces/Time stamp\nstring frame_id\n";
+
+/// `geometry_msgs/Point`.
+pub const POINT_MSG: &str = "float64 x\nfloat64 y\nfloat64 z\n";
+
+/// `geometry_msgs/Vector3`.
+pub const VECTOR3_MSG: &str = "float64 x\nfloat64 y\nfloat64 z\n";
+
+/// `geometry_msgs/Quaternion` (identity by default).
+pub const QUATERNION_MSG: &str = "float64 x 0\nfloat64 y 0\nfloat64 z 0\nfloat64 w 1\n";
+
+/// `geometry_msgs/Pose`.
+pub const POSE_MSG: &str = "Point position\nQuaternion orientation\n";
+
+/// `geometry_msgs/PoseWithCovariance`.
+pub const POSE_WITH_COVARIANCE_MSG: &str = "Pose pose\nfloat64[36] covariance\n";
+
+/// `geometry_msgs/Twist`.
+pub const TWIST_MSG: &str = "Vector3 linear\nVector3 angular\n";
+
+/// `geometry_msgs/TwistWithCovariance`.
+pub const TWIST_WITH_COVARIANCE_MSG: &str = "Twist twist\nfloat64[36] covariance\n";
+
+/// `geometry_msgs/TwistWithCovarianceStamped`.
+pub const TWIST_WITH_COVARIANCE_STAMPED_MSG: &str =
+    "std_msgs/Header header\nTwistWithCovariance twist\n";
+
+/// `geometry_msgs/Transform`.
+pub const TRANSFORM_MSG: &str = "Vector3 translation\nQuaternion rotation\n";
+
+/// `geometry_msgs/TransformStamped`.
+pub const TRANSFORM_STAMPED_MSG: &str =
+    "std_msgs/Header header\nstring child_frame_id\nTransform transform\n";
+
+/// `sensor_msgs/Imu`.
+pub const IMU_MSG: &str = "\
+std_msgs/Header header
+geometry_msgs/Quaternion orientation
+float64[9] orientation_covariance
+geometry_msgs/Vector3 angular_velocity
+float64[9] angular_velocity_covariance
+geometry_msgs/Vector3 linear_acceleration
+float64[9] linear_acceleration_covariance
+";
+
+/// `sensor_msgs/NavSatStatus`.
+pub const NAV_SAT_STATUS_MSG: &str = "\
+int8 STATUS_UNKNOWN = -2
+int8 STATUS_NO_FIX = -1
+int8 STATUS_FIX = 0
+int8 STATUS_SBAS_FIX = 1
+int8 STATUS_GBAS_FIX = 2
+int8 status
+uint16 SERVICE_UNKNOWN = 0
+uint16 SERVICE_GPS = 1
+uint16 SERVICE_GLONASS = 2
+uint16 SERVICE_COMPASS = 4
+uint16 SERVICE_GALILEO = 8
+uint16 service
+";
+
+/// `sensor_msgs/NavSatFix`.
+pub const NAV_SAT_FIX_MSG: &str = "\
+std_msgs/Header header
+NavSatStatus status
+float64 latitude
+float64 longitude
+float64 altitude
+float64[9] position_covariance
+uint8 COVARIANCE_TYPE_UNKNOWN = 0
+uint8 COVARIANCE_TYPE_APPROXIMATED = 1
+uint8 COVARIANCE_TYPE_DIAGONAL_KNOWN = 2
+uint8 COVARIANCE_TYPE_KNOWN = 3
+uint8 position_covariance_type
+";
+
+/// `nav_msgs/Odometry`.
+pub const ODOMETRY_MSG: &str = "\
+std_msgs/Header header
+string child_frame_id
+geometry_msgs/PoseWithCovariance pose
+geometry_msgs/TwistWithCovariance twist
+";
+
+/// `diagnostic_msgs/KeyValue`.
+pub const KEY_VALUE_MSG: &str = "string key\nstring value\n";
+
+/// `diagnostic_msgs/DiagnosticStatus`.
+pub const DIAGNOSTIC_STATUS_MSG: &str = "\
+byte OK=0
+byte WARN=1
+byte ERROR=2
+byte STALE=3
+byte level
+string name
+string message
+string hardware_id
+KeyValue[] values
+";
+
+/// `diagnostic_msgs/DiagnosticArray`.
+pub const DIAGNOSTIC_ARRAY_MSG: &str = "std_msgs/Header header\nDiagnosticStatus[] status\n";
+
+/// `tf2_msgs/TFMessage`.
+pub const TF_MESSAGE_MSG: &str = "geometry_msgs/TransformStamped[] transforms\n";
+
+/// `rosgraph_msgs/Clock`.
+pub const CLOCK_MSG: &str = "builtin_interfaces/Time clock\n";
+
+/// Every known definition text, keyed by `pkg/Type` (no `msg/` in the middle).
+const DEFINITIONS: &[(&str, &str)] = &[
+    ("builtin_interfaces/Time", TIME_MSG),
+    ("std_msgs/Header", HEADER_MSG),
+    ("geometry_msgs/Point", POINT_MSG),
+    ("geometry_msgs/Vector3", VECTOR3_MSG),
+    ("geometry_msgs/Quaternion", QUATERNION_MSG),
+    ("geometry_msgs/Pose", POSE_MSG),
+    ("geometry_msgs/PoseWithCovariance", POSE_WITH_COVARIANCE_MSG),
+    ("geometry_msgs/Twist", TWIST_MSG),
+    (
+        "geometry_msgs/TwistWithCovariance",
+        TWIST_WITH_COVARIANCE_MSG,
+    ),
+    (
+        "geometry_msgs/TwistWithCovarianceStamped",
+        TWIST_WITH_COVARIANCE_STAMPED_MSG,
+    ),
+    ("geometry_msgs/Transform", TRANSFORM_MSG),
+    ("geometry_msgs/TransformStamped", TRANSFORM_STAMPED_MSG),
+    ("sensor_msgs/Imu", IMU_MSG),
+    ("sensor_msgs/NavSatStatus", NAV_SAT_STATUS_MSG),
+    ("sensor_msgs/NavSatFix", NAV_SAT_FIX_MSG),
+    ("nav_msgs/Odometry", ODOMETRY_MSG),
+    ("diagnostic_msgs/KeyValue", KEY_VALUE_MSG),
+    ("diagnostic_msgs/DiagnosticStatus", DIAGNOSTIC_STATUS_MSG),
+    ("diagnostic_msgs/DiagnosticArray", DIAGNOSTIC_ARRAY_MSG),
+    ("tf2_msgs/TFMessage", TF_MESSAGE_MSG),
+    ("rosgraph_msgs/Clock", CLOCK_MSG),
+    (
+        "adaptive_gnss_ins/SatelliteMeasurement",
+        SATELLITE_MEASUREMENT_MSG,
+    ),
+    ("adaptive_gnss_ins/GnssMeasurements", GNSS_MEASUREMENTS_MSG),
+    ("adaptive_gnss_ins/SatelliteNoise", SATELLITE_NOISE_MSG),
+    ("adaptive_gnss_ins/NoiseEstimates", NOISE_ESTIMATES_MSG),
+];
+
+/// The definition text of `short_name` (`pkg/Type`), or None when this crate has none.
+pub fn definition_text(short_name: &str) -> Option<&'static str> {
+    DEFINITIONS
+        .iter()
+        .find(|(name, _)| *name == short_name)
+        .map(|(_, text)| *text)
+}

@@ -1,0 +1,231 @@
+//! Engine outputs to ROS messages: nav_msgs/Odometry (REP-103/105: pose in a local ENU
+//! frame at the datum, twist in the body frame), sensor_msgs/NavSatFix and our
+//! NoiseEstimates (the covariance-diagnostic topic).
+
+use nalgebra::{Matrix3, SMatrix};
+
+use crate::earth::{self, Llh};
+use crate::engine::{EpochReport, SatRejection, Solution};
+use crate::ins::error_state::{DV, GYRO_BIAS, GYRO_GM};
+
+use super::msg::{
+    Header, NavSatFix, NavSatStatus, NoiseEstimates, Odometry, Point, Pose, PoseWithCovariance,
+    Quaternion, SatelliteNoise, Time, Twist, TwistWithCovariance, Vector3,
+};
+
+fn vector3(v: &nalgebra::Vector3<f64>) -> Vector3 {
+    Vector3 {
+        x: v[0],
+        y: v[1],
+        z: v[2],
+    }
+}
+
+fn row_major_6(m: &SMatrix<f64, 6, 6>) -> [f64; 36] {
+    std::array::from_fn(|k| m[(k / 6, k % 6)])
+}
+
+/// nav_msgs/Odometry of `solution`: pose of the body in the ENU frame `frame_id` whose
+/// origin is `datum`; twist in the body frame `child_frame_id`.
+///
+/// Covariances: the pose's (E, N, U, rotations about E, N, U) from the filter; the twist's
+/// linear part is the ENU velocity covariance rotated into the body; its angular part is
+/// the covariance of the estimated gyro bias (the rate itself is measured).
+pub fn odometry(
+    solution: &Solution,
+    datum: &Llh,
+    stamp: Time,
+    frame_id: &str,
+    child_frame_id: &str,
+) -> Odometry {
+    let nav = &solution.nav;
+    let position = earth::llh_to_enu(&nav.p, datum);
+    let q = nav.q_nb.quaternion();
+    let c_nb = nav.q_nb.inverse();
+    let w_in = earth::earth_rate_enu_rad_s(nav.p.lat_rad)
+        + earth::transport_rate_enu_rad_s(&nav.p, &nav.v_n);
+    let angular = solution.angular_rate_b_rad_s - c_nb * w_in;
+    let c = c_nb.to_rotation_matrix().into_inner();
+    let p_v: Matrix3<f64> = solution.covariance.fixed_view::<3, 3>(DV, DV).into();
+    let p_bias: Matrix3<f64> = solution
+        .covariance
+        .fixed_view::<3, 3>(GYRO_BIAS, GYRO_BIAS)
+        .into_owned()
+        + solution.covariance.fixed_view::<3, 3>(GYRO_GM, GYRO_GM);
+    let mut twist_cov = SMatrix::<f64, 6, 6>::zeros();
+    twist_cov
+        .fixed_view_mut::<3, 3>(0, 0)
+        .copy_from(&(c * p_v * c.transpose()));
+    twist_cov.fixed_view_mut::<3, 3>(3, 3).copy_from(&p_bias);
+    Odometry {
+        header: Header {
+            stamp,
+            frame_id: frame_id.to_owned(),
+        },
+        child_frame_id: child_frame_id.to_owned(),
+        pose: PoseWithCovariance {
+            pose: Pose {
+                position: Point {
+                    x: position[0],
+                    y: position[1],
+                    z: position[2],
+                },
+                orientation: Quaternion {
+                    x: q.i,
+                    y: q.j,
+                    z: q.k,
+                    w: q.w,
+                },
+            },
+            covariance: row_major_6(&solution.pose_covariance_enu()),
+        },
+        twist: TwistWithCovariance {
+            twist: Twist {
+                linear: vector3(&(c_nb * nav.v_n)),
+                angular: vector3(&angular),
+            },
+            covariance: row_major_6(&twist_cov),
+        },
+    }
+}
+
+/// sensor_msgs/NavSatFix of the body position, with its ENU covariance (known).
+pub fn nav_sat_fix(solution: &Solution, stamp: Time, frame_id: &str) -> NavSatFix {
+    let p = &solution.nav.p;
+    let cov = solution.position_covariance_enu_m2();
+    NavSatFix {
+        header: Header {
+            stamp,
+            frame_id: frame_id.to_owned(),
+        },
+        status: NavSatStatus {
+            status: NavSatStatus::STATUS_FIX,
+            service: NavSatStatus::SERVICE_GPS,
+        },
+        latitude: p.lat_rad.to_degrees(),
+        longitude: p.lon_rad.to_degrees(),
+        altitude: p.height_m,
+        position_covariance: std::array::from_fn(|k| cov[(k / 3, k % 3)]),
+        position_covariance_type: NavSatFix::COVARIANCE_TYPE_KNOWN,
+    }
+}
+
+fn rejection_code(reason: Option<SatRejection>) -> u8 {
+    match reason {
+        None => SatelliteNoise::REJECTION_NONE,
+        Some(SatRejection::ElevationMask) => SatelliteNoise::REJECTION_ELEVATION_MASK,
+        Some(SatRejection::Cn0Mask) => SatelliteNoise::REJECTION_CN0_MASK,
+        Some(SatRejection::InnovationGate) => SatelliteNoise::REJECTION_INNOVATION_GATE,
+        Some(SatRejection::NotANumber) => SatelliteNoise::REJECTION_NOT_A_NUMBER,
+        Some(SatRejection::NoSatelliteState) => SatelliteNoise::REJECTION_NO_EPHEMERIS_STATE,
+        Some(SatRejection::Mahalanobis) => SatelliteNoise::REJECTION_MAHALANOBIS,
+        Some(SatRejection::ConstellationDisabled) => {
+            SatelliteNoise::REJECTION_CONSTELLATION_DISABLED
+        }
+    }
+}
+
+/// Our NoiseEstimates message of one epoch report.
+pub fn noise_estimates(report: &EpochReport, stamp: Time, frame_id: &str) -> NoiseEstimates {
+    NoiseEstimates {
+        header: Header {
+            stamp,
+            frame_id: frame_id.to_owned(),
+        },
+        filter_variant: report.variant.to_owned(),
+        satellites: report
+            .satellites
+            .iter()
+            .map(|s| SatelliteNoise {
+                constellation: s.sat.constellation.code(),
+                prn: s.sat.prn,
+                elevation_deg: s.elevation_rad.to_degrees(),
+                used: s.used_pseudorange || s.used_rate,
+                rejection_reason: rejection_code(s.rejection),
+                innovation_pseudorange_m: s.innovation_pseudorange_m,
+                innovation_pseudorange_rate_mps: s.innovation_rate_mps,
+                normalized_innovation_pseudorange: s.normalized_innovation_pseudorange,
+                normalized_innovation_pseudorange_rate: s.normalized_innovation_rate,
+                r_pseudorange_m2: s.r_pseudorange_m2,
+                r_pseudorange_rate_m2_s2: s.r_rate_m2_s2,
+                kde_credibility: s.kde_credibility,
+                gaussian: s.gaussian.unwrap_or(true),
+                ar_order: s.ar_order.unwrap_or(0),
+                robust_weight: s.robust_weight,
+            })
+            .collect(),
+        adaptive_factor: report.adaptive_factor,
+        mahalanobis_d2: report.mahalanobis_d2,
+        chi2_threshold: report.chi2_threshold,
+        q_scale: report.q_scale,
+        nis: report.nis,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ins::error_state::{StateMatrix, DP};
+    use crate::ins::NavState;
+    use nalgebra::UnitQuaternion;
+
+    fn solution() -> (Solution, Llh) {
+        let datum = Llh::from_degrees(40.0, -105.0, 1600.0);
+        let p = earth::enu_to_llh(&nalgebra::Vector3::new(10.0, -3.0, 1.0), &datum).unwrap();
+        let mut covariance = StateMatrix::identity() * 1e-4;
+        let (north, _) = earth::metres_per_radian(&p);
+        covariance[(DP, DP)] = 4.0 / (north * north);
+        let sol = Solution {
+            nav: NavState {
+                t_s: 12.5,
+                p,
+                v_n: nalgebra::Vector3::new(0.0, 5.0, 0.0),
+                // Facing north (ENU yaw 90°).
+                q_nb: UnitQuaternion::from_euler_angles(0.0, 0.0, std::f64::consts::FRAC_PI_2),
+            },
+            covariance,
+            gyro_bias_rad_s: nalgebra::Vector3::zeros(),
+            accel_bias_m_s2: nalgebra::Vector3::zeros(),
+            clock_bias_m: 0.0,
+            clock_drift_mps: 0.0,
+            angular_rate_b_rad_s: nalgebra::Vector3::new(0.0, 0.0, 0.1),
+        };
+        (sol, datum)
+    }
+
+    #[test]
+    fn odometry_pose_is_enu_at_the_datum_and_twist_is_in_the_body() {
+        let (sol, datum) = solution();
+        let stamp = Time {
+            sec: 12,
+            nanosec: 500_000_000,
+        };
+        let odom = odometry(&sol, &datum, stamp, "map", "base_link");
+        let p = &odom.pose.pose.position;
+        assert!((p.x - 10.0).abs() < 1e-6 && (p.y + 3.0).abs() < 1e-6 && (p.z - 1.0).abs() < 1e-6);
+        let o = &odom.pose.pose.orientation;
+        let half = std::f64::consts::FRAC_PI_4;
+        assert!((o.z - half.sin()).abs() < 1e-12 && (o.w - half.cos()).abs() < 1e-12);
+        // Moving north while facing north: forward (body x) at 5 m/s.
+        let v = &odom.twist.twist.linear;
+        assert!((v.x - 5.0).abs() < 1e-9 && v.y.abs() < 1e-9 && v.z.abs() < 1e-9);
+        // Yaw rate less the earth and transport rates (a few 1e-5 rad/s).
+        assert!((odom.twist.twist.angular.z - 0.1).abs() < 1e-4);
+        // Pose covariance: the north variance (row 1, column 1) from δL.
+        assert!((odom.pose.covariance[7] - 4.0).abs() < 1e-9);
+        assert_eq!(odom.header.frame_id, "map");
+        assert_eq!(odom.child_frame_id, "base_link");
+    }
+
+    #[test]
+    fn nav_sat_fix_carries_degrees_and_the_enu_covariance() {
+        let (sol, _) = solution();
+        let fix = nav_sat_fix(&sol, Time::default(), "base_link");
+        assert!((fix.latitude - sol.nav.p.lat_rad.to_degrees()).abs() < 1e-12);
+        assert!((fix.position_covariance[4] - 4.0).abs() < 1e-9);
+        assert_eq!(
+            fix.position_covariance_type,
+            NavSatFix::COVARIANCE_TYPE_KNOWN
+        );
+    }
+}

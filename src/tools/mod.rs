@@ -1,0 +1,5 @@
+//! The offline tools behind the `gnss_ins` command (simulate, replay, compare, demo): they
+//! read and write files and drive the one engine the live node uses.
+
+pub mod compare;
+pub mod session;

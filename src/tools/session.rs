@@ -1,0 +1,228 @@
+//! One run of the engine over a recorded or simulated stream, with scoring against the
+//! reference when there is one. The same code serves `replay`, `compare` and `demo`.
+
+use std::collections::{BTreeMap, HashMap};
+
+use crate::config::Config;
+use crate::engine::{Engine, EpochReport, GnssFix, InputRejected, Output, Solution};
+use crate::eval::{self, ErrorSummary, SolutionError, TruthSample, TruthTrack};
+use crate::gnss::{GnssEpoch, SatId};
+use crate::ins::ImuSample;
+
+/// One input of a session, in time order.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SessionInput {
+    Imu(ImuSample),
+    Gnss(GnssEpoch),
+    Fix(GnssFix),
+    /// A reference sample at an IMU time (scored against the solution of that time).
+    Truth(TruthSample),
+    /// The true noise σ of each satellite at an epoch: (sat, range σ m, rate σ m/s).
+    TruthSigmas {
+        t_s: f64,
+        sigmas: Vec<(SatId, f64, f64)>,
+    },
+    /// The environment in force from `t_s` on (simulated data).
+    Environment {
+        t_s: f64,
+        name: String,
+    },
+}
+
+/// The estimated pseudo-range σ of one satellite at one epoch beside the true one.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SigmaSample {
+    pub t_s: f64,
+    pub sat: SatId,
+    pub environment: String,
+    pub estimated_sigma_m: f64,
+    pub true_sigma_m: f64,
+}
+
+/// A session's results.
+#[derive(Debug, Clone, Default)]
+pub struct SessionReport {
+    /// Errors of the scored solutions with the environment they were in.
+    pub errors: Vec<(String, SolutionError)>,
+    pub sigmas: Vec<SigmaSample>,
+    pub solutions: usize,
+    pub epochs: usize,
+    pub rejected: Vec<InputRejected>,
+}
+
+impl SessionReport {
+    /// Summary over all scored solutions at or after `from_t_s`.
+    pub fn summary(&self, from_t_s: f64) -> ErrorSummary {
+        let errors: Vec<SolutionError> = self
+            .errors
+            .iter()
+            .filter(|(_, e)| e.t_s >= from_t_s)
+            .map(|(_, e)| *e)
+            .collect();
+        eval::summarize(&errors)
+    }
+
+    /// Summary per environment.
+    pub fn summary_by_environment(&self, from_t_s: f64) -> BTreeMap<String, ErrorSummary> {
+        let mut by_env: BTreeMap<String, Vec<SolutionError>> = BTreeMap::new();
+        for (env, e) in self.errors.iter().filter(|(_, e)| e.t_s >= from_t_s) {
+            by_env.entry(env.clone()).or_default().push(*e);
+        }
+        by_env
+            .into_iter()
+            .map(|(k, v)| (k, eval::summarize(&v)))
+            .collect()
+    }
+
+    /// RMS of (estimated − true) pseudo-range σ over the satellites and epochs of an
+    /// environment (m); NaN without samples.
+    pub fn sigma_rms_error_m(&self, environment: &str) -> f64 {
+        let d: Vec<f64> = self
+            .sigmas
+            .iter()
+            .filter(|s| s.environment == environment)
+            .map(|s| s.estimated_sigma_m - s.true_sigma_m)
+            .collect();
+        if d.is_empty() {
+            f64::NAN
+        } else {
+            (d.iter().map(|x| x * x).sum::<f64>() / d.len() as f64).sqrt()
+        }
+    }
+}
+
+/// Drives an [`Engine`] and scores its solutions.
+pub struct Session {
+    engine: Engine,
+    /// Scores at most this often (s); 0 scores every match.
+    score_interval_s: f64,
+    last_scored_t_s: f64,
+    /// A preloaded reference (e.g. a CSV); otherwise references come as inputs.
+    track: Option<TruthTrack>,
+    latest: Option<Solution>,
+    environment: String,
+    truth_sigmas: HashMap<u64, Vec<(SatId, f64, f64)>>,
+    report: SessionReport,
+}
+
+/// Times are matched to the microsecond.
+fn time_key(t_s: f64) -> u64 {
+    (t_s * 1e6).round() as u64
+}
+
+impl Session {
+    pub fn new(config: Config, score_interval_s: f64, track: Option<TruthTrack>) -> Self {
+        Self {
+            engine: Engine::new(config),
+            score_interval_s,
+            last_scored_t_s: f64::NEG_INFINITY,
+            track,
+            latest: None,
+            environment: "unlabelled".to_owned(),
+            truth_sigmas: HashMap::new(),
+            report: SessionReport::default(),
+        }
+    }
+
+    pub fn engine(&self) -> &Engine {
+        &self.engine
+    }
+
+    /// Feeds one input; returns the engine's outputs (for writing).
+    pub fn push(&mut self, input: SessionInput) -> Vec<Output> {
+        let result = match input {
+            SessionInput::Imu(s) => self.engine.push_imu(&s),
+            SessionInput::Gnss(e) => self.engine.push_gnss(e),
+            SessionInput::Fix(f) => self.engine.push_fix(f),
+            SessionInput::Truth(t) => {
+                self.score_streamed(&t);
+                return Vec::new();
+            }
+            SessionInput::TruthSigmas { t_s, sigmas } => {
+                self.truth_sigmas.insert(time_key(t_s), sigmas);
+                return Vec::new();
+            }
+            SessionInput::Environment { name, .. } => {
+                self.environment = name;
+                return Vec::new();
+            }
+        };
+        match result {
+            Ok(outputs) => {
+                for o in &outputs {
+                    self.observe(o);
+                }
+                outputs
+            }
+            Err(rejected) => {
+                self.report.rejected.push(rejected);
+                Vec::new()
+            }
+        }
+    }
+
+    fn observe(&mut self, output: &Output) {
+        match output {
+            Output::Solution(sol) => {
+                self.report.solutions += 1;
+                if let Some(track) = &self.track {
+                    let t = sol.nav.t_s;
+                    if t - self.last_scored_t_s >= self.score_interval_s {
+                        if let Some(truth) = track.at(t) {
+                            self.record(sol, &truth);
+                        }
+                    }
+                }
+                self.latest = Some((**sol).clone());
+            }
+            Output::Epoch(report) => {
+                self.report.epochs += 1;
+                self.record_sigmas(report);
+            }
+            Output::Status(_) => {}
+        }
+    }
+
+    fn score_streamed(&mut self, truth: &TruthSample) {
+        let Some(sol) = self.latest.take() else {
+            return;
+        };
+        if (sol.nav.t_s - truth.t_s).abs() < 1e-6
+            && truth.t_s - self.last_scored_t_s >= self.score_interval_s
+        {
+            self.record(&sol, truth);
+        }
+        self.latest = Some(sol);
+    }
+
+    fn record(&mut self, sol: &Solution, truth: &TruthSample) {
+        self.last_scored_t_s = sol.nav.t_s;
+        let error = eval::solution_error(sol, truth);
+        self.report.errors.push((self.environment.clone(), error));
+    }
+
+    fn record_sigmas(&mut self, report: &EpochReport) {
+        let Some(truth) = self.truth_sigmas.remove(&time_key(report.t_s)) else {
+            return;
+        };
+        // Older entries can no longer be matched (reports come in time order).
+        let key = time_key(report.t_s);
+        self.truth_sigmas.retain(|&k, _| k > key);
+        for sat in report.satellites.iter().filter(|s| s.used_pseudorange) {
+            if let Some(&(_, sigma_m, _)) = truth.iter().find(|(id, _, _)| *id == sat.sat) {
+                self.report.sigmas.push(SigmaSample {
+                    t_s: report.t_s,
+                    sat: sat.sat,
+                    environment: self.environment.clone(),
+                    estimated_sigma_m: sat.r_pseudorange_m2.sqrt(),
+                    true_sigma_m: sigma_m,
+                });
+            }
+        }
+    }
+
+    /// Ends the session.
+    pub fn finish(self) -> SessionReport {
+        self.report
+    }
+}
