@@ -4,8 +4,7 @@
 
 use adaptive_gnss_ins::config::Config;
 use adaptive_gnss_ins::earth::{self, Llh};
-use adaptive_gnss_ins::engine::adaptive_noise::NoiseModel;
-use adaptive_gnss_ins::engine::{process_noise, tight_update, FilterState};
+use adaptive_gnss_ins::engine::{process_noise, tight_update, Adaptation, FilterState};
 use adaptive_gnss_ins::gnss::GnssEpoch;
 use adaptive_gnss_ins::ins::error_state::StateMatrix;
 use adaptive_gnss_ins::ins::{ImuSample, NavState};
@@ -91,15 +90,17 @@ fn tc_update(c: &mut Criterion) {
     let epoch = epoch_12(&p);
     let start = running_state(p);
     let w = Vector3::zeros();
+    let adaptation = Adaptation::new(&config);
     c.bench_function("tc_update_12_satellites", |b| {
         b.iter(|| {
             let mut state = start.clone();
+            let mut adaptation = adaptation.clone();
             let report = tight_update::update(
                 &mut state,
                 black_box(&epoch),
                 &w,
                 &config,
-                &mut NoiseModel::Fixed,
+                &mut adaptation,
                 true,
             )
             .expect("update");

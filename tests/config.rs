@@ -3,7 +3,8 @@
 use std::path::{Path, PathBuf};
 
 use adaptive_gnss_ins::config::{
-    Config, ConfigError, Coupling, PARAMETER_OVERRIDE_ORIGIN, RAD_PER_DEG, RAD_S_PER_DEG_H,
+    Config, ConfigError, Coupling, FilterVariant, PARAMETER_OVERRIDE_ORIGIN, RAD_PER_DEG,
+    RAD_S_PER_DEG_H,
 };
 use adaptive_gnss_ins::gnss::Constellation;
 use serde_yaml::Value;
@@ -50,7 +51,7 @@ fn assert_names(error: &ConfigError, key: &str, origin: &str) {
 
 /// Every non-default value of every key, to check that each key is read and echoed.
 const EVERY_KEY_CHANGED: &str = "
-    filter: {variant: ermakf, coupling: loose, joseph_form: false}
+    filter: {variant: ermakf, coupling: loose, joseph_form: false, base: cubature, q_scaling: true}
     imu:
       gyro_arw_deg_per_sqrt_h: 0.15
       gyro_bias_deg_per_h: 3.3
@@ -99,6 +100,24 @@ const EVERY_KEY_CHANGED: &str = "
       pseudorange_rate_sigma_min_mps: 0.03
       pseudorange_rate_sigma_max_mps: 5.0
       max_epoch_gap_s: 3.0
+    robust:
+      adaptive_factor_function: three_segment
+      adaptive_factor_c: 1.2
+      adaptive_factor_c0: 1.3
+      adaptive_factor_c1: 6.0
+      alpha_floor: 0.05
+      equivalent_weight_function: igg3
+      double_factor_c: 1.1
+      igg3_k0: 1.2
+      igg3_k1: 4.0
+      max_variance_inflation: 1000.0
+      chi2_confidence: 0.99
+      residual_window_epochs: 32
+      q_window_epochs: 40
+      q_alpha_min: 0.1
+      q_alpha_max: 10.0
+      q_scale_min: 0.01
+      q_scale_max: 100.0
     init:
       heading_deg: -37.3
       heading_min_speed_mps: 2.0
@@ -139,6 +158,55 @@ fn ekf_loose_preset_differs_from_the_default_only_in_coupling() {
     let mut expected = Config::default();
     expected.filter.coupling = Coupling::Loose;
     assert_eq!(load("ekf_loose.yaml"), expected);
+}
+
+/// The variant presets differ from the default only in `filter.variant`.
+#[test]
+fn variant_presets_differ_from_the_default_only_in_the_variant() {
+    for variant in FilterVariant::ALL {
+        let name = format!("{}.yaml", variant.as_str());
+        let mut expected = Config::default();
+        expected.filter.variant = variant;
+        assert_eq!(load(&name), expected, "{name}");
+    }
+}
+
+/// The IARF paper's loose set-up: its fix variances (0.5 m)², (0.05 m/s)² (section 5).
+#[test]
+fn iarf_loose_preset_is_the_papers_set_up() {
+    let mut expected = Config::default();
+    expected.filter.variant = FilterVariant::Iarf;
+    expected.filter.coupling = Coupling::Loose;
+    expected.loose.fix_sigma_horizontal_m = 0.5;
+    expected.loose.fix_sigma_vertical_m = 0.5;
+    expected.loose.velocity_sigma_mps = 0.05;
+    let config = load("iarf_loose.yaml");
+    assert_eq!(config, expected);
+    assert!(config.filter.uses_cubature());
+}
+
+#[test]
+fn robust_constants_out_of_range_are_refused() {
+    for (body, key) in [
+        (
+            "    robust: {adaptive_factor_c0: 2.0, adaptive_factor_c1: 1.5}\n",
+            "robust.adaptive_factor_c1",
+        ),
+        ("    robust: {alpha_floor: 0.0}\n", "robust.alpha_floor"),
+        ("    robust: {igg3_k1: 1.0}\n", "robust.igg3_k1"),
+        (
+            "    robust: {chi2_confidence: 1.0}\n",
+            "robust.chi2_confidence",
+        ),
+        (
+            "    robust: {q_window_epochs: 2}\n",
+            "robust.q_window_epochs",
+        ),
+        ("    robust: {q_alpha_max: 0.5}\n", "robust.q_alpha_max"),
+        ("    filter: {variant: ckf, base: ekf}\n", "filter.base"),
+    ] {
+        assert_names(&load_error(body), key, "test.yaml");
+    }
 }
 
 /// The manual can't drift: each preset lists every key, each key is preceded by a comment

@@ -8,11 +8,11 @@ use nalgebra::{UnitQuaternion, Vector3};
 
 use super::raw::{
     RawAdaptive, RawClock, RawConfig, RawEngine, RawFilter, RawGnss, RawImu, RawInit, RawLoose,
-    RawMounting, RawOutput,
+    RawMounting, RawOutput, RawRobust,
 };
 use super::{
     AdaptiveConfig, ClockConfig, Config, EngineConfig, FilterConfig, GnssConfig, ImuConfig,
-    InitConfig, LooseConfig, MountingConfig, OutputConfig,
+    InitConfig, LooseConfig, MountingConfig, OutputConfig, RobustConfig,
 };
 use crate::earth::Llh;
 
@@ -76,6 +76,7 @@ impl From<&RawConfig> for Config {
             gnss,
             loose,
             adaptive,
+            robust,
             init,
             engine,
             output,
@@ -85,6 +86,8 @@ impl From<&RawConfig> for Config {
                 variant: filter.variant,
                 coupling: filter.coupling,
                 joseph_form: filter.joseph_form,
+                base: filter.base,
+                q_scaling: filter.q_scaling,
             },
             imu: ImuConfig {
                 gyro_arw_rad_per_sqrt_s: imu.gyro_arw_deg_per_sqrt_h
@@ -141,6 +144,25 @@ impl From<&RawConfig> for Config {
                 pseudorange_rate_sigma_max_mps: adaptive.pseudorange_rate_sigma_max_mps,
                 max_epoch_gap_s: adaptive.max_epoch_gap_s,
             },
+            robust: RobustConfig {
+                adaptive_factor_function: robust.adaptive_factor_function,
+                adaptive_factor_c: robust.adaptive_factor_c,
+                adaptive_factor_c0: robust.adaptive_factor_c0,
+                adaptive_factor_c1: robust.adaptive_factor_c1,
+                alpha_floor: robust.alpha_floor,
+                equivalent_weight_function: robust.equivalent_weight_function,
+                double_factor_c: robust.double_factor_c,
+                igg3_k0: robust.igg3_k0,
+                igg3_k1: robust.igg3_k1,
+                max_variance_inflation: robust.max_variance_inflation,
+                chi2_confidence: robust.chi2_confidence,
+                residual_window_epochs: robust.residual_window_epochs,
+                q_window_epochs: robust.q_window_epochs,
+                q_alpha_min: robust.q_alpha_min,
+                q_alpha_max: robust.q_alpha_max,
+                q_scale_min: robust.q_scale_min,
+                q_scale_max: robust.q_scale_max,
+            },
             init: InitConfig {
                 heading_rad: init.heading_deg.map(|deg| deg * RAD_PER_DEG),
                 heading_min_speed_mps: init.heading_min_speed_mps,
@@ -178,6 +200,7 @@ impl From<&Config> for RawConfig {
             gnss,
             loose,
             adaptive,
+            robust,
             init,
             engine,
             output,
@@ -188,6 +211,8 @@ impl From<&Config> for RawConfig {
                 variant: filter.variant,
                 coupling: filter.coupling,
                 joseph_form: filter.joseph_form,
+                base: filter.base,
+                q_scaling: filter.q_scaling,
             },
             imu: RawImu {
                 gyro_arw_deg_per_sqrt_h: si_to_human(
@@ -248,6 +273,25 @@ impl From<&Config> for RawConfig {
                 pseudorange_rate_sigma_min_mps: adaptive.pseudorange_rate_sigma_min_mps,
                 pseudorange_rate_sigma_max_mps: adaptive.pseudorange_rate_sigma_max_mps,
                 max_epoch_gap_s: adaptive.max_epoch_gap_s,
+            },
+            robust: RawRobust {
+                adaptive_factor_function: robust.adaptive_factor_function,
+                adaptive_factor_c: robust.adaptive_factor_c,
+                adaptive_factor_c0: robust.adaptive_factor_c0,
+                adaptive_factor_c1: robust.adaptive_factor_c1,
+                alpha_floor: robust.alpha_floor,
+                equivalent_weight_function: robust.equivalent_weight_function,
+                double_factor_c: robust.double_factor_c,
+                igg3_k0: robust.igg3_k0,
+                igg3_k1: robust.igg3_k1,
+                max_variance_inflation: robust.max_variance_inflation,
+                chi2_confidence: robust.chi2_confidence,
+                residual_window_epochs: robust.residual_window_epochs,
+                q_window_epochs: robust.q_window_epochs,
+                q_alpha_min: robust.q_alpha_min,
+                q_alpha_max: robust.q_alpha_max,
+                q_scale_min: robust.q_scale_min,
+                q_scale_max: robust.q_scale_max,
             },
             init: RawInit {
                 heading_deg: init.heading_rad.map(deg),

@@ -30,11 +30,12 @@ pub use convert::{
 pub use error::ConfigError;
 pub use raw::{
     ConstellationName, RawAdaptive, RawClock, RawConfig, RawEngine, RawFilter, RawGnss, RawImu,
-    RawInit, RawLoose, RawMounting, RawOutput,
+    RawInit, RawLoose, RawMounting, RawOutput, RawRobust,
 };
 pub use sections::{
-    AdaptiveConfig, ClockConfig, Config, Coupling, EngineConfig, FilterConfig, FilterVariant,
-    GnssConfig, ImuConfig, InitConfig, LooseConfig, MountingConfig, OutputConfig,
+    AdaptiveConfig, AdaptiveFactorKind, ClockConfig, Config, Coupling, EngineConfig,
+    EquivalentWeightKind, FilterBase, FilterConfig, FilterVariant, GnssConfig, ImuConfig,
+    InitConfig, LooseConfig, MountingConfig, OutputConfig, RobustConfig,
 };
 
 /// The origin quoted in errors from [`Config::set_parameter`].

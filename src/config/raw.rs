@@ -5,7 +5,7 @@
 
 use serde::Deserialize;
 
-use super::{Coupling, FilterVariant};
+use super::{AdaptiveFactorKind, Coupling, EquivalentWeightKind, FilterBase, FilterVariant};
 use crate::adaptive::burg::OrderCriterion;
 use crate::gnss::Constellation;
 
@@ -20,6 +20,7 @@ pub struct RawConfig {
     pub gnss: RawGnss,
     pub loose: RawLoose,
     pub adaptive: RawAdaptive,
+    pub robust: RawRobust,
     pub init: RawInit,
     pub engine: RawEngine,
     pub output: RawOutput,
@@ -32,6 +33,8 @@ pub struct RawFilter {
     pub variant: FilterVariant,
     pub coupling: Coupling,
     pub joseph_form: bool,
+    pub base: FilterBase,
+    pub q_scaling: bool,
 }
 
 impl Default for RawFilter {
@@ -40,6 +43,8 @@ impl Default for RawFilter {
             variant: FilterVariant::Ekf,
             coupling: Coupling::Tight,
             joseph_form: true,
+            base: FilterBase::Auto,
+            q_scaling: false,
         }
     }
 }
@@ -197,6 +202,53 @@ impl Default for RawAdaptive {
             pseudorange_rate_sigma_min_mps: 0.02,
             pseudorange_rate_sigma_max_mps: 10.0,
             max_epoch_gap_s: 2.0,
+        }
+    }
+}
+
+/// `robust.*`: IARF-paper and Ding constants (see [`super::RobustConfig`]).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RawRobust {
+    pub adaptive_factor_function: AdaptiveFactorKind,
+    pub adaptive_factor_c: f64,
+    pub adaptive_factor_c0: f64,
+    pub adaptive_factor_c1: f64,
+    pub alpha_floor: f64,
+    pub equivalent_weight_function: EquivalentWeightKind,
+    pub double_factor_c: f64,
+    pub igg3_k0: f64,
+    pub igg3_k1: f64,
+    pub max_variance_inflation: f64,
+    pub chi2_confidence: f64,
+    pub residual_window_epochs: usize,
+    pub q_window_epochs: usize,
+    pub q_alpha_min: f64,
+    pub q_alpha_max: f64,
+    pub q_scale_min: f64,
+    pub q_scale_max: f64,
+}
+
+impl Default for RawRobust {
+    fn default() -> Self {
+        Self {
+            adaptive_factor_function: AdaptiveFactorKind::TwoSegment,
+            adaptive_factor_c: 1.0,
+            adaptive_factor_c0: 1.0,
+            adaptive_factor_c1: 3.0,
+            alpha_floor: 0.01,
+            equivalent_weight_function: EquivalentWeightKind::DoubleFactor,
+            double_factor_c: 1.5,
+            igg3_k0: 1.5,
+            igg3_k1: 3.0,
+            max_variance_inflation: 1e6,
+            chi2_confidence: 0.95,
+            residual_window_epochs: 64,
+            q_window_epochs: 64,
+            q_alpha_min: 0.01,
+            q_alpha_max: 100.0,
+            q_scale_min: 0.001,
+            q_scale_max: 1000.0,
         }
     }
 }

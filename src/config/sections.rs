@@ -17,6 +17,7 @@ pub struct Config {
     pub gnss: GnssConfig,
     pub loose: LooseConfig,
     pub adaptive: AdaptiveConfig,
+    pub robust: RobustConfig,
     pub init: InitConfig,
     pub engine: EngineConfig,
     pub output: OutputConfig,
@@ -40,11 +41,37 @@ pub enum FilterVariant {
     /// `ermakf`: the enhanced redundant-measurement AKF: random weighting (eq. 19), KDE
     /// detection (eqs. 20–24) and the Burg/Akaike AR variance (eqs. 25–29).
     Ermakf,
+    /// `ckf`: the cubature Kalman filter of the IARF paper (scheme 1 of its section 5),
+    /// fixed noise, no adaptive factor, no robust step.
+    Ckf,
+    /// `akf_all`: the adaptive filter with the factor α of the predicted residual
+    /// (section 2.2) at every epoch (IARF paper, scheme 2).
+    AkfAll,
+    /// `akf_partial`: the adaptive filter only at the epochs that pass the Mahalanobis test
+    /// (section 3), α = 1 at the others (IARF paper, scheme 3).
+    AkfPartial,
+    /// `iarf`: the improved adaptively-robust filter (IARF paper, section 3, scheme 4): the
+    /// robust equivalent covariance R̄ at every epoch, the adaptive factor only at the
+    /// epochs that pass the Mahalanobis test.
+    Iarf,
+    /// `residual_akf`: online stochastic modelling of R from the post-update residuals
+    /// (Ding, Wang and Rizos 2007, eqs. 14–15).
+    ResidualAkf,
 }
 
 impl FilterVariant {
     /// Every variant, in the order of the documentation.
-    pub const ALL: [FilterVariant; 4] = [Self::Ekf, Self::Eiakf, Self::Srmakf, Self::Ermakf];
+    pub const ALL: [FilterVariant; 9] = [
+        Self::Ekf,
+        Self::Eiakf,
+        Self::Srmakf,
+        Self::Ermakf,
+        Self::Ckf,
+        Self::AkfAll,
+        Self::AkfPartial,
+        Self::Iarf,
+        Self::ResidualAkf,
+    ];
 
     /// The name used in the parameter file.
     pub fn as_str(self) -> &'static str {
@@ -53,6 +80,84 @@ impl FilterVariant {
             Self::Eiakf => "eiakf",
             Self::Srmakf => "srmakf",
             Self::Ermakf => "ermakf",
+            Self::Ckf => "ckf",
+            Self::AkfAll => "akf_all",
+            Self::AkfPartial => "akf_partial",
+            Self::Iarf => "iarf",
+            Self::ResidualAkf => "residual_akf",
+        }
+    }
+
+    /// True for the variants of the IARF paper, whose experiments all run on the cubature
+    /// filter (section 5): `ckf`, `akf_all`, `akf_partial`, `iarf`.
+    pub fn is_iarf_family(self) -> bool {
+        matches!(
+            self,
+            Self::Ckf | Self::AkfAll | Self::AkfPartial | Self::Iarf
+        )
+    }
+}
+
+/// The base filter of the measurement update (`filter.base`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FilterBase {
+    /// `auto`: cubature for the IARF-paper variants (`ckf`, `akf_all`, `akf_partial`,
+    /// `iarf`), the EKF for every other variant.
+    Auto,
+    /// `ekf`: the linearized (extended) update.
+    Ekf,
+    /// `cubature`: the cubature Kalman filter update (2n points).
+    Cubature,
+}
+
+impl FilterBase {
+    /// The name used in the parameter file.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Auto => "auto",
+            Self::Ekf => "ekf",
+            Self::Cubature => "cubature",
+        }
+    }
+}
+
+/// The adaptive-factor function of the IARF paper, section 2.2 (`robust.adaptive_factor_function`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AdaptiveFactorKind {
+    /// `two_segment`: eq. (9), threshold c.
+    TwoSegment,
+    /// `three_segment`: eq. (10), thresholds c0 < c1.
+    ThreeSegment,
+}
+
+impl AdaptiveFactorKind {
+    /// The name used in the parameter file.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::TwoSegment => "two_segment",
+            Self::ThreeSegment => "three_segment",
+        }
+    }
+}
+
+/// The equivalent-weight function of the robust step (`robust.equivalent_weight_function`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EquivalentWeightKind {
+    /// `double_factor`: the IARF paper's double factor, section 3 (threshold c).
+    DoubleFactor,
+    /// `igg3`: Yang's IGG-III (thresholds k0 < k1).
+    Igg3,
+}
+
+impl EquivalentWeightKind {
+    /// The name used in the parameter file.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::DoubleFactor => "double_factor",
+            Self::Igg3 => "igg3",
         }
     }
 }
@@ -86,6 +191,22 @@ pub struct FilterConfig {
     pub coupling: Coupling,
     /// `filter.joseph_form` (default `true`): covariance update P = (I−KH)P(I−KH)ᵀ + KRKᵀ.
     pub joseph_form: bool,
+    /// `filter.base` (default `auto`): the base filter of the measurement update.
+    pub base: FilterBase,
+    /// `filter.q_scaling` (default `false`): Ding's process-noise scaling, eqs. (19), (22),
+    /// combinable with every variant.
+    pub q_scaling: bool,
+}
+
+impl FilterConfig {
+    /// True when the measurement update is the cubature one (`filter.base` resolved).
+    pub fn uses_cubature(&self) -> bool {
+        match self.base {
+            FilterBase::Auto => self.variant.is_iarf_family(),
+            FilterBase::Ekf => false,
+            FilterBase::Cubature => true,
+        }
+    }
 }
 
 /// `imu.*`, in SI.
@@ -221,6 +342,48 @@ pub struct AdaptiveConfig {
     /// Longest gap between two epochs of a satellite over which ∇Z is still formed (s),
     /// `adaptive.max_epoch_gap_s` (default `2.0`).
     pub max_epoch_gap_s: f64,
+}
+
+/// `robust.*`: the constants of the IARF-paper schemes (adaptive factor, robust equivalent
+/// covariance, Mahalanobis test) and of Ding's residual R and Q scaling. All are
+/// dimensionless unless a unit is named.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RobustConfig {
+    /// `robust.adaptive_factor_function` (default `two_segment`).
+    pub adaptive_factor_function: AdaptiveFactorKind,
+    /// Threshold c of eq. (9), `robust.adaptive_factor_c` (default `1.0`).
+    pub adaptive_factor_c: f64,
+    /// Thresholds c0, c1 of eq. (10), `robust.adaptive_factor_c0` (default `1.0`) and
+    /// `robust.adaptive_factor_c1` (default `3.0`).
+    pub adaptive_factor_c0: f64,
+    pub adaptive_factor_c1: f64,
+    /// Floor of α, `robust.alpha_floor` (default `0.01`).
+    pub alpha_floor: f64,
+    /// `robust.equivalent_weight_function` (default `double_factor`).
+    pub equivalent_weight_function: EquivalentWeightKind,
+    /// Threshold c of the double factor, `robust.double_factor_c` (default `1.5`).
+    pub double_factor_c: f64,
+    /// IGG-III thresholds, `robust.igg3_k0` (default `1.5`), `robust.igg3_k1` (default `3.0`).
+    pub igg3_k0: f64,
+    pub igg3_k1: f64,
+    /// Largest variance inflation λ_ii, `robust.max_variance_inflation` (default `1e6`).
+    pub max_variance_inflation: f64,
+    /// Confidence of the χ² test of M², `robust.chi2_confidence` (default `0.95`).
+    pub chi2_confidence: f64,
+    /// Window m of the residual-based R, eq. (15) (epochs), `robust.residual_window_epochs`
+    /// (default `64`).
+    pub residual_window_epochs: usize,
+    /// Window m of the Q-scaling factor, eq. (19) (epochs), `robust.q_window_epochs`
+    /// (default `64`).
+    pub q_window_epochs: usize,
+    /// Bounds on one α of eq. (19), `robust.q_alpha_min` (default `0.01`) and
+    /// `robust.q_alpha_max` (default `100.0`).
+    pub q_alpha_min: f64,
+    pub q_alpha_max: f64,
+    /// Bounds on the accumulated scale of Q, `robust.q_scale_min` (default `0.001`) and
+    /// `robust.q_scale_max` (default `1000.0`).
+    pub q_scale_min: f64,
+    pub q_scale_max: f64,
 }
 
 /// `init.*`: start-up and initial 1σ of the state blocks, in SI.

@@ -16,6 +16,7 @@ impl RawConfig {
         let g = &self.gnss;
         let l = &self.loose;
         let a = &self.adaptive;
+        let r = &self.robust;
         let n = &self.init;
         let e = &self.engine;
         let o = &self.output;
@@ -27,6 +28,8 @@ impl RawConfig {
                     ("variant", text(f.variant.as_str())),
                     ("coupling", text(f.coupling.as_str())),
                     ("joseph_form", Value::Bool(f.joseph_form)),
+                    ("base", text(f.base.as_str())),
+                    ("q_scaling", Value::Bool(f.q_scaling)),
                 ],
             ),
             (
@@ -123,6 +126,37 @@ impl RawConfig {
                         num(a.pseudorange_rate_sigma_max_mps),
                     ),
                     ("max_epoch_gap_s", num(a.max_epoch_gap_s)),
+                ],
+            ),
+            (
+                "robust",
+                vec![
+                    (
+                        "adaptive_factor_function",
+                        text(r.adaptive_factor_function.as_str()),
+                    ),
+                    ("adaptive_factor_c", num(r.adaptive_factor_c)),
+                    ("adaptive_factor_c0", num(r.adaptive_factor_c0)),
+                    ("adaptive_factor_c1", num(r.adaptive_factor_c1)),
+                    ("alpha_floor", num(r.alpha_floor)),
+                    (
+                        "equivalent_weight_function",
+                        text(r.equivalent_weight_function.as_str()),
+                    ),
+                    ("double_factor_c", num(r.double_factor_c)),
+                    ("igg3_k0", num(r.igg3_k0)),
+                    ("igg3_k1", num(r.igg3_k1)),
+                    ("max_variance_inflation", num(r.max_variance_inflation)),
+                    ("chi2_confidence", num(r.chi2_confidence)),
+                    (
+                        "residual_window_epochs",
+                        Value::from(r.residual_window_epochs),
+                    ),
+                    ("q_window_epochs", Value::from(r.q_window_epochs)),
+                    ("q_alpha_min", num(r.q_alpha_min)),
+                    ("q_alpha_max", num(r.q_alpha_max)),
+                    ("q_scale_min", num(r.q_scale_min)),
+                    ("q_scale_max", num(r.q_scale_max)),
                 ],
             ),
             (

@@ -6,7 +6,7 @@
 //! (horizon), `output.rate_hz`, and the mounting angles and lever arm.
 
 use super::raw::RawConfig;
-use super::ConfigError;
+use super::{ConfigError, FilterBase, FilterVariant};
 
 /// Checks every value of `raw`; `origin` names the file in the error.
 pub fn validate(raw: &RawConfig, origin: &str) -> Result<(), ConfigError> {
@@ -95,6 +95,7 @@ pub fn validate(raw: &RawConfig, origin: &str) -> Result<(), ConfigError> {
     c.positive("loose.velocity_sigma_mps", loose.velocity_sigma_mps)?;
 
     validate_adaptive(raw, &c)?;
+    validate_robust(raw, &c)?;
 
     let init = &raw.init;
     if let Some(heading) = init.heading_deg {
@@ -223,6 +224,79 @@ fn validate_adaptive(raw: &RawConfig, c: &Checker) -> Result<(), ConfigError> {
         if !(max.is_finite() && max >= min) {
             return Err(c.invalid(key, max, "must be finite and at least the minimum"));
         }
+    }
+    Ok(())
+}
+
+fn validate_robust(raw: &RawConfig, c: &Checker) -> Result<(), ConfigError> {
+    let f = &raw.filter;
+    if f.base == FilterBase::Ekf && f.variant == FilterVariant::Ckf {
+        return Err(ConfigError::Invalid {
+            origin: c.origin.to_owned(),
+            key: "filter.base".to_owned(),
+            value: "ekf".to_owned(),
+            reason: "variant ckf is the cubature filter; use variant ekf for the EKF".to_owned(),
+        });
+    }
+    let r = &raw.robust;
+    c.positive("robust.adaptive_factor_c", r.adaptive_factor_c)?;
+    c.positive("robust.adaptive_factor_c0", r.adaptive_factor_c0)?;
+    if !(r.adaptive_factor_c1.is_finite() && r.adaptive_factor_c1 > r.adaptive_factor_c0) {
+        return Err(c.invalid(
+            "robust.adaptive_factor_c1",
+            r.adaptive_factor_c1,
+            "must be finite and > robust.adaptive_factor_c0",
+        ));
+    }
+    if !(r.alpha_floor.is_finite() && r.alpha_floor > 0.0 && r.alpha_floor <= 1.0) {
+        return Err(c.invalid("robust.alpha_floor", r.alpha_floor, "must lie in (0, 1]"));
+    }
+    c.positive("robust.double_factor_c", r.double_factor_c)?;
+    c.positive("robust.igg3_k0", r.igg3_k0)?;
+    if !(r.igg3_k1.is_finite() && r.igg3_k1 > r.igg3_k0) {
+        return Err(c.invalid(
+            "robust.igg3_k1",
+            r.igg3_k1,
+            "must be finite and > robust.igg3_k0",
+        ));
+    }
+    c.within(
+        "robust.max_variance_inflation",
+        r.max_variance_inflation,
+        1.0,
+        1e12,
+        "must lie in [1, 1e12]",
+    )?;
+    // Choice: a confidence below one half would raise alarms on most healthy epochs.
+    if !(r.chi2_confidence.is_finite() && r.chi2_confidence >= 0.5 && r.chi2_confidence < 1.0) {
+        return Err(c.invalid(
+            "robust.chi2_confidence",
+            r.chi2_confidence,
+            "must lie in [0.5, 1)",
+        ));
+    }
+    // Choice: a second moment from fewer than 5 epochs is noise (spread above 60 %).
+    for (key, value) in [
+        ("robust.residual_window_epochs", r.residual_window_epochs),
+        ("robust.q_window_epochs", r.q_window_epochs),
+    ] {
+        if value < 5 {
+            return Err(c.invalid(key, value as f64, "must be at least 5"));
+        }
+    }
+    for (key, value) in [
+        ("robust.q_alpha_min", r.q_alpha_min),
+        ("robust.q_scale_min", r.q_scale_min),
+    ] {
+        if !(value.is_finite() && value > 0.0 && value <= 1.0) {
+            return Err(c.invalid(key, value, "must lie in (0, 1]"));
+        }
+    }
+    for (key, value) in [
+        ("robust.q_alpha_max", r.q_alpha_max),
+        ("robust.q_scale_max", r.q_scale_max),
+    ] {
+        c.within(key, value, 1.0, 1e12, "must lie in [1, 1e12]")?;
     }
     Ok(())
 }

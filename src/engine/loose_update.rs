@@ -5,12 +5,14 @@ use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
 use crate::config::Config;
 use crate::earth::{self, Llh};
-use crate::filter::ekf::{self, FilterError};
+use crate::filter::ekf::FilterError;
 use crate::filter::measurement_rows::AntennaGeometry;
 use crate::ins::error_state::N;
 
+use super::adaptation::Adaptation;
 use super::filter_state::FilterState;
 use super::output::{EpochReport, MeasurementKind};
+use super::robust_update::MeasurementSet;
 
 /// A receiver's own solution of the antenna position (and optionally velocity).
 #[derive(Debug, Clone, PartialEq)]
@@ -67,43 +69,100 @@ fn velocity_covariance(fix: &GnssFix, config: &Config) -> Matrix3<f64> {
     }
 }
 
-/// Updates `state` with `fix`.
+/// The fix's innovation (predicted − measured) from `state`: the antenna position error in
+/// the ENU frame `rot_ecef_to_enu` (held at the nominal point of the update, so every
+/// cubature point is expressed in one frame), then the ENU velocity error when the fix has
+/// a velocity.
+fn fix_innovation(
+    state: &FilterState,
+    fix: &GnssFix,
+    fix_ecef_m: &Vector3<f64>,
+    rot_ecef_to_enu: &Matrix3<f64>,
+    w_ib_b_rad_s: &Vector3<f64>,
+    config: &Config,
+) -> DVector<f64> {
+    let geo = AntennaGeometry::new(&state.nav, &config.mounting.lever_arm_b_m, w_ib_b_rad_s);
+    let y_pos = rot_ecef_to_enu * (geo.antenna_ecef_m(&state.nav.p) - fix_ecef_m);
+    match fix.velocity_enu_mps {
+        Some(v) => {
+            let y_vel = state.nav.v_n + geo.lever_velocity_enu_mps() - v;
+            DVector::from_iterator(6, y_pos.iter().chain(y_vel.iter()).copied())
+        }
+        None => DVector::from_iterator(3, y_pos.iter().copied()),
+    }
+}
+
+/// Updates `state` with `fix` by the configured base filter and scheme; `adaptation`
+/// learns from it unless `learn` is false (a fix re-applied after a roll-back).
+///
+/// Choice: the measured values of the loose model are taken as zero and the "prediction"
+/// of a state is its innovation with respect to the fix, so the post-update residual of
+/// Ding's eq. (14) is the innovation of the corrected state.
 pub fn update(
     state: &mut FilterState,
     fix: &GnssFix,
     w_ib_b_rad_s: &Vector3<f64>,
     config: &Config,
+    adaptation: &mut Adaptation,
+    learn: bool,
 ) -> Result<EpochReport, FilterError> {
     let geo = AntennaGeometry::new(&state.nav, &config.mounting.lever_arm_b_m, w_ib_b_rad_s);
-    // Position innovation in the ENU frame at the nominal point (predicted − measured).
-    let predicted_ecef = geo.antenna_ecef_m(&state.nav.p);
-    let y_pos =
-        earth::rot_ecef_to_enu(&state.nav.p) * (predicted_ecef - earth::llh_to_ecef(&fix.position));
-    let with_velocity = fix.velocity_enu_mps.is_some();
-    let m = if with_velocity { 6 } else { 3 };
+    let rot = earth::rot_ecef_to_enu(&state.nav.p);
+    let fix_ecef = earth::llh_to_ecef(&fix.position);
+    let y = fix_innovation(state, fix, &fix_ecef, &rot, w_ib_b_rad_s, config);
+    let m = y.len();
     let mut h = DMatrix::zeros(m, N);
-    let mut y = DVector::zeros(m);
     let mut r = DMatrix::zeros(m, m);
     for (i, row) in geo.position_rows().iter().enumerate() {
         h.row_mut(i).copy_from(row);
-        y[i] = y_pos[i];
     }
     r.view_mut((0, 0), (3, 3))
         .copy_from(&position_covariance(fix, config));
-    if let Some(v) = fix.velocity_enu_mps {
-        let y_vel = state.nav.v_n + geo.lever_velocity_enu_mps() - v;
+    if fix.velocity_enu_mps.is_some() {
         for (i, row) in geo.velocity_rows().iter().enumerate() {
             h.row_mut(3 + i).copy_from(row);
-            y[3 + i] = y_vel[i];
         }
         r.view_mut((3, 3), (3, 3))
             .copy_from(&velocity_covariance(fix, config));
     }
-    let result = ekf::update(&state.p, &h, &y, &r, config.filter.joseph_form)?;
-    state.p = result.p;
-    state.apply_correction(&result.dx);
+    let r = adaptation.noise.fix_covariance(&r);
+    let predict = |s: &FilterState| {
+        Some(fix_innovation(
+            s,
+            fix,
+            &fix_ecef,
+            &rot,
+            w_ib_b_rad_s,
+            config,
+        ))
+    };
+    let set = MeasurementSet {
+        h: h.clone(),
+        y,
+        r,
+        predict: &predict,
+    };
+    let result = adaptation.update.update(state, &set)?;
     let mut report = EpochReport::new(fix.t_s, MeasurementKind::Fix, config);
     report.measurements_used = m;
     report.nis = result.nis;
+    report.adaptive_factor = result.adaptive_factor;
+    report.mahalanobis_d2 = result.mahalanobis_d2;
+    report.chi2_threshold = result.chi2_threshold;
+    report.q_scale = adaptation.q.scale();
+    if result.robust_weights.iter().all(|w| w.is_finite()) {
+        report.fix_robust_weights = result.robust_weights.iter().copied().collect();
+    }
+    if learn {
+        adaptation
+            .q
+            .push(&result.innovation, &result.r, &result.hph);
+        let residual = -fix_innovation(state, fix, &fix_ecef, &rot, w_ib_b_rad_s, config);
+        let p = DMatrix::from_column_slice(N, N, state.p.as_slice());
+        let hph = &h * p * h.transpose();
+        adaptation
+            .noise
+            .after_fix_update(fix.t_s, &residual, &((&hph + hph.transpose()) * 0.5));
+    }
     Ok(report)
 }

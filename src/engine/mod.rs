@@ -14,12 +14,15 @@
 //!   the last stored state before it, applies it, and re-integrates the buffered IMU
 //!   samples; one older than `engine.imu_buffer_s` is rejected and counted.
 
+mod adaptation;
 pub mod adaptive_noise;
 mod filter_state;
 mod initializer;
 pub mod loose_update;
 mod output;
+pub mod q_scaling;
 mod rejection;
+pub mod robust_update;
 pub mod tight_update;
 
 use std::collections::VecDeque;
@@ -29,8 +32,7 @@ use crate::filter::process_model::ProcessNoise;
 use crate::gnss::GnssEpoch;
 use crate::ins::ImuSample;
 
-use adaptive_noise::NoiseModel;
-
+pub use adaptation::Adaptation;
 pub use filter_state::{interpolate, FilterState};
 pub use initializer::{InitPhase, Initializer};
 pub use loose_update::GnssFix;
@@ -91,14 +93,19 @@ pub struct Engine {
     counters: RejectionCounters,
     /// Solutions are not emitted while re-integrating after a roll-back.
     replaying: bool,
-    noise_model: NoiseModel,
+    /// Noise strategy, update scheme and Q scaling of the variant.
+    ///
+    /// Choice: the learned Q scale lives here, not in the stored states, so states
+    /// re-integrated after a roll-back use the scale of now; the estimators learn only from
+    /// measurements seen for the first time.
+    adaptation: Adaptation,
 }
 
 impl Engine {
     pub fn new(config: Config) -> Self {
         let process_noise = process_noise(&config);
         Self {
-            noise_model: NoiseModel::new(&config),
+            adaptation: Adaptation::new(&config),
             config,
             process_noise,
             phase: Phase::Initializing(Box::default()),
@@ -141,6 +148,11 @@ impl Engine {
         self.imu.back().map(|s| s.t_s)
     }
 
+    /// The factor on the configured process noise Q in use (1 without `filter.q_scaling`).
+    pub fn q_scale(&self) -> f64 {
+        self.adaptation.q.scale()
+    }
+
     /// The configured filter variant's name.
     pub fn variant_name(&self) -> &'static str {
         self.config.filter.variant.as_str()
@@ -158,7 +170,7 @@ impl Engine {
             Phase::Initializing(_) => Box::default(),
         };
         self.phase = Phase::Initializing(init);
-        self.noise_model.reset();
+        self.adaptation.reset();
         self.imu.clear();
         self.history.clear();
         self.pending.clear();
@@ -349,7 +361,8 @@ impl Engine {
             Phase::Initializing(init) => init.push_imu(s, &self.config),
             Phase::Running(state) => {
                 if state.last_imu.t_s < s.t_s {
-                    if let Err(e) = state.propagate(s, &self.process_noise) {
+                    let noise = self.process_noise.scaled(self.adaptation.q.scale());
+                    if let Err(e) = state.propagate(s, &noise) {
                         log::warn!("IMU step to t = {:.6} s failed: {e}", s.t_s);
                         self.counters.reject(RejectionReason::ImuStepFailed, s.t_s);
                         let reset = self.reset(s.t_s, ResetReason::Diverged);
@@ -407,7 +420,8 @@ impl Engine {
             Phase::Running(state) => {
                 if state.last_imu.t_s < t {
                     let at_t = interpolate(&state.last_imu, next, t);
-                    if let Err(e) = state.propagate(&at_t, &self.process_noise) {
+                    let noise = self.process_noise.scaled(self.adaptation.q.scale());
+                    if let Err(e) = state.propagate(&at_t, &noise) {
                         log::warn!("IMU step to the measurement at t = {t:.6} s failed: {e}");
                         self.counters.reject(RejectionReason::ImuStepFailed, t);
                         return;
@@ -415,12 +429,14 @@ impl Engine {
                 }
                 let w = state.compensate(&state.last_imu).w_ib_b_rad_s;
                 let before = state.as_ref().clone();
-                let noise = &mut self.noise_model;
+                let adaptation = &mut self.adaptation;
                 let result = match &p.measurement {
                     Measurement::Gnss(e) => {
-                        tight_update::update(state, e, &w, &self.config, noise, report)
+                        tight_update::update(state, e, &w, &self.config, adaptation, report)
                     }
-                    Measurement::Fix(f) => loose_update::update(state, f, &w, &self.config),
+                    Measurement::Fix(f) => {
+                        loose_update::update(state, f, &w, &self.config, adaptation, report)
+                    }
                 };
                 match result {
                     Ok(epoch) if state.is_finite() => {
@@ -429,6 +445,9 @@ impl Engine {
                         }
                     }
                     Ok(_) | Err(_) => {
+                        if let Err(e) = &result {
+                            log::warn!("update at t = {t:.3} s failed: {e}");
+                        }
                         **state = before;
                         self.counters.reject(RejectionReason::UpdateFailed, t);
                     }

@@ -174,6 +174,10 @@ pub struct EpochReport {
     pub chi2_threshold: f64,
     /// Process-noise scale in use (1 = the configured Q).
     pub q_scale: f64,
+    /// Robust weight 1/λ_ii per row of a loosely-coupled fix (E, N, U position, then the
+    /// velocity rows); empty without a robust scheme and in tight coupling, where the
+    /// weights are per satellite.
+    pub fix_robust_weights: Vec<f64>,
 }
 
 impl EpochReport {
@@ -191,6 +195,7 @@ impl EpochReport {
             mahalanobis_d2: f64::NAN,
             chi2_threshold: f64::NAN,
             q_scale: 1.0,
+            fix_robust_weights: Vec::new(),
         }
     }
 }

@@ -1,19 +1,22 @@
 //! The tightly-coupled measurement update of one GNSS epoch: prediction of every
 //! satellite's pseudo-range and rate from the nominal state (eqs. 7–9), screening, clock
-//! jump absorption, innovation gating, the EKF update and the feedback.
+//! jump absorption, the noise strategy, innovation gating, the update of the configured
+//! base filter and scheme ([`super::robust_update`]) and the feedback.
 
 use nalgebra::{DMatrix, DVector, Vector3};
 
 use crate::config::Config;
-use crate::filter::ekf::{self, FilterError};
+use crate::filter::ekf::FilterError;
 use crate::filter::measurement_rows::{AntennaGeometry, Row};
 use crate::gnss::geometry::{self, SatPrediction};
 use crate::gnss::spp::SigmaModel;
 use crate::gnss::GnssEpoch;
 
-use super::adaptive_noise::{NoiseModel, Observable, ScalarMeasurement};
+use super::adaptation::Adaptation;
+use super::adaptive_noise::{Observable, ScalarMeasurement};
 use super::filter_state::FilterState;
 use super::output::{EpochReport, MeasurementKind, SatRejection, SatReport};
+use super::robust_update::MeasurementSet;
 
 /// One scalar measurement that passed the screening.
 struct Candidate {
@@ -55,17 +58,19 @@ pub fn sigma_model(config: &Config) -> SigmaModel {
 }
 
 /// Updates `state` with `epoch`; `w_ib_b_rad_s` is the compensated body rate at the epoch
-/// (for the lever-arm velocity); `noise` gives the variances (with `learn` false for
-/// measurements re-applied after a roll-back). Returns the epoch report; on a filter
-/// failure the state is unchanged and the error is returned.
+/// (for the lever-arm velocity); `adaptation` gives the variances and the update and learns
+/// from the epoch (not when `learn` is false: measurements re-applied after a roll-back).
+/// Returns the epoch report; on a filter failure the state is unchanged and the error is
+/// returned.
 pub fn update(
     state: &mut FilterState,
     epoch: &GnssEpoch,
     w_ib_b_rad_s: &Vector3<f64>,
     config: &Config,
-    noise: &mut NoiseModel,
+    adaptation: &mut Adaptation,
     learn: bool,
 ) -> Result<EpochReport, FilterError> {
+    let noise = &mut adaptation.noise;
     let geo = AntennaGeometry::new(&state.nav, &config.mounting.lever_arm_b_m, w_ib_b_rad_s);
     let rx_pos = geo.antenna_ecef_m(&state.nav.p);
     let rx_vel = geo.antenna_velocity_ecef_mps(&state.nav.v_n);
@@ -138,12 +143,14 @@ pub fn update(
         .map(|c| c.obs_index)
         .zip(scalars)
         .collect();
+    let screened_rows: Vec<Row> = candidates.iter().map(|c| c.row).collect();
     gate(
         &mut candidates,
         &state.p,
         config.gnss.innovation_gate_sigma,
         &mut report,
     );
+    report.q_scale = adaptation.q.scale();
     if !candidates.is_empty() {
         let m = candidates.len();
         let mut h = DMatrix::zeros(m, crate::ins::error_state::N);
@@ -154,30 +161,84 @@ pub fn update(
             y[i] = c.y();
             r[(i, i)] = c.r;
         }
-        let result = ekf::update(&state.p, &h, &y, &r, config.filter.joseph_form)?;
+        let predict =
+            |s: &FilterState| predict_candidates(s, &candidates, epoch, w_ib_b_rad_s, config);
+        let set = MeasurementSet {
+            h,
+            y,
+            r,
+            predict: &predict,
+        };
+        let result = adaptation.update.update(state, &set)?;
         for (i, c) in candidates.iter().enumerate() {
             let sat = &mut report.satellites[c.sat_index];
-            let normalized = -c.y() / result.s[(i, i)].sqrt();
+            let normalized = -result.innovation[i] / result.s[(i, i)].sqrt();
             if c.is_rate() {
                 sat.used_rate = true;
-                sat.innovation_rate_mps = -c.y();
+                sat.innovation_rate_mps = -result.innovation[i];
                 sat.normalized_innovation_rate = normalized;
             } else {
                 sat.used_pseudorange = true;
-                sat.innovation_pseudorange_m = -c.y();
+                sat.innovation_pseudorange_m = -result.innovation[i];
                 sat.normalized_innovation_pseudorange = normalized;
+                // Choice: like the KDE fields, the robust weight describes the pseudo-range.
+                sat.robust_weight = result.robust_weights[i];
             }
         }
-        state.p = result.p;
-        state.apply_correction(&result.dx);
         report.measurements_used = m;
         report.nis = result.nis;
+        report.adaptive_factor = result.adaptive_factor;
+        report.mahalanobis_d2 = result.mahalanobis_d2;
+        report.chi2_threshold = result.chi2_threshold;
+        if learn {
+            adaptation
+                .q
+                .push(&result.innovation, &result.r, &result.hph);
+        }
     }
-    if learn && noise.wants_posterior_predictions() {
+    if learn && adaptation.noise.wants_posterior_predictions() {
+        let posterior_hph: Vec<f64> = screened_rows
+            .iter()
+            .map(|row| (row * state.p * row.transpose())[(0, 0)])
+            .collect();
         let (rows, posterior) = posterior_predictions(state, epoch, w_ib_b_rad_s, config, screened);
-        noise.after_update(epoch.t_s, &rows, &posterior);
+        adaptation
+            .noise
+            .after_update(epoch.t_s, &rows, &posterior, &posterior_hph);
     }
     Ok(report)
+}
+
+/// The predictions of the candidates (same order) from `state`; None when one fails.
+fn predict_candidates(
+    state: &FilterState,
+    candidates: &[Candidate],
+    epoch: &GnssEpoch,
+    w_ib_b_rad_s: &Vector3<f64>,
+    config: &Config,
+) -> Option<DVector<f64>> {
+    let geo = AntennaGeometry::new(&state.nav, &config.mounting.lever_arm_b_m, w_ib_b_rad_s);
+    let rx_pos = geo.antenna_ecef_m(&state.nav.p);
+    let rx_vel = geo.antenna_velocity_ecef_mps(&state.nav.v_n);
+    let mut out = DVector::zeros(candidates.len());
+    for (i, c) in candidates.iter().enumerate() {
+        let obs = epoch.satellites.get(c.obs_index)?;
+        let p = geometry::predict(
+            obs,
+            &rx_pos,
+            &rx_vel,
+            state.clock_bias_m,
+            state.clock_drift_mps,
+            epoch.klobuchar.as_ref(),
+            epoch.gps_time_of_week_s,
+        )
+        .ok()?;
+        out[i] = match c.observable {
+            Observable::Pseudorange => p.pseudorange_m,
+            Observable::PseudorangeRate => p.pseudorange_rate_mps,
+        };
+    }
+    Some(out)
 }
 
 /// The screened measurements with their predictions from the corrected state (NaN where

@@ -23,6 +23,16 @@ pub enum FilterError {
     },
     #[error("the update produced a non-finite state or covariance")]
     NonFinite,
+    /// The cubature update failed (a covariance could not be factored, a model output was
+    /// not finite).
+    #[error("cubature update: {0}")]
+    Cubature(#[from] crate::filter::cubature::CubatureError),
+    /// A step of the adaptive or robust schemes failed.
+    #[error("adaptive/robust step: {0}")]
+    Adaptive(#[from] crate::adaptive::math_error::AdaptiveMathError),
+    /// A covariance could not be factored.
+    #[error(transparent)]
+    Linalg(#[from] crate::linalg::LinalgError),
 }
 
 /// (A + Aᵀ)/2.

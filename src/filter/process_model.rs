@@ -38,6 +38,26 @@ pub struct ProcessNoise {
     pub clock_drift_time_s: f64,
 }
 
+impl ProcessNoise {
+    /// The process noise with every spectral density multiplied by `factor` (> 0): the
+    /// white-noise amplitudes and the Gauss-Markov σ scale by √factor, the correlation times
+    /// stay. Math note: the continuous Q of [`noise_density`] is then `factor` times the
+    /// original (q = σ_w² for white noise, 2σ²/T for a Gauss-Markov process), and the system
+    /// matrix, which holds only the correlation times, is unchanged.
+    pub fn scaled(&self, factor: f64) -> Self {
+        let k = factor.sqrt();
+        Self {
+            gyro_arw_rad_per_sqrt_s: self.gyro_arw_rad_per_sqrt_s * k,
+            gyro_markov_sigma_rad_s: self.gyro_markov_sigma_rad_s * k,
+            accel_vrw_m_s_per_sqrt_s: self.accel_vrw_m_s_per_sqrt_s * k,
+            accel_bias_sigma_m_s2: self.accel_bias_sigma_m_s2 * k,
+            clock_bias_noise_m_per_sqrt_s: self.clock_bias_noise_m_per_sqrt_s * k,
+            clock_drift_noise_m_s_per_sqrt_s: self.clock_drift_noise_m_s_per_sqrt_s * k,
+            ..*self
+        }
+    }
+}
+
 /// The inputs the linearization needs: the nominal state and the bias-compensated
 /// specific force in the body frame over the interval.
 #[derive(Debug, Clone, Copy)]
@@ -260,6 +280,29 @@ pub fn propagate_covariance(
 mod tests {
     use super::*;
     use nalgebra::{DMatrix, UnitQuaternion};
+
+    #[test]
+    fn scaled_noise_scales_the_density_and_keeps_the_dynamics() {
+        let n = noise();
+        let s = n.scaled(7.5);
+        let (q0, q1) = (noise_density(&n), noise_density(&s));
+        for i in 0..q0.len() {
+            assert!(
+                (q1[i] - 7.5 * q0[i]).abs() <= 1e-12 * q0[i].abs(),
+                "state {i}"
+            );
+        }
+        let lin = LinearizationPoint {
+            nav: crate::ins::NavState {
+                t_s: 0.0,
+                p: crate::earth::Llh::from_degrees(40.0, 116.0, 50.0),
+                v_n: nalgebra::Vector3::new(3.0, 4.0, 0.1),
+                q_nb: UnitQuaternion::identity(),
+            },
+            f_ib_b_m_s2: nalgebra::Vector3::new(0.1, 0.2, 9.8),
+        };
+        assert_eq!(system_matrix(&lin, &n), system_matrix(&lin, &s));
+    }
 
     fn noise() -> ProcessNoise {
         ProcessNoise {

@@ -1,15 +1,20 @@
-//! The measurement-noise strategies of the filter variants: fixed (ekf), innovation-based
-//! (eiakf) and redundant-measurement based (srmakf, ermakf). Each is asked, per epoch, for
-//! the variance R of every scalar measurement, one estimator per satellite and observable.
+//! The measurement-noise strategies of the filter variants: fixed (ekf and the IARF-paper
+//! variants), innovation-based (eiakf), redundant-measurement based (srmakf, ermakf) and
+//! residual-based (residual_akf). Each is asked, per epoch, for the variance R of every
+//! scalar measurement, one estimator per satellite and observable.
 
 mod innovation;
 mod redundant;
+mod residual;
+
+use nalgebra::{DMatrix, DVector};
 
 use crate::config::{Config, FilterVariant};
 use crate::gnss::SatId;
 
 pub use innovation::InnovationNoise;
 pub use redundant::RedundantNoise;
+pub use residual::ResidualNoise;
 
 /// Which observable a scalar measurement is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -68,12 +73,19 @@ pub enum NoiseModel {
     Fixed,
     Innovation(Box<InnovationNoise>),
     Redundant(Box<RedundantNoise>),
+    /// Ding, Wang and Rizos' residual-based R, eqs. (14)–(15).
+    Residual(Box<ResidualNoise>),
 }
 
 impl NoiseModel {
     pub fn new(config: &Config) -> Self {
         match config.filter.variant {
-            FilterVariant::Ekf => Self::Fixed,
+            FilterVariant::Ekf
+            | FilterVariant::Ckf
+            | FilterVariant::AkfAll
+            | FilterVariant::AkfPartial
+            | FilterVariant::Iarf => Self::Fixed,
+            FilterVariant::ResidualAkf => Self::Residual(Box::new(ResidualNoise::new(config))),
             FilterVariant::Eiakf => Self::Innovation(Box::new(InnovationNoise::new(config))),
             FilterVariant::Srmakf => Self::Redundant(Box::new(RedundantNoise::new(config, false))),
             FilterVariant::Ermakf => Self::Redundant(Box::new(RedundantNoise::new(config, true))),
@@ -95,18 +107,44 @@ impl NoiseModel {
                 .collect(),
             Self::Innovation(m) => m.variances(t_s, rows, learn),
             Self::Redundant(m) => m.variances(t_s, rows, learn),
+            Self::Residual(m) => m.variances(rows),
         }
     }
 
     /// True when the strategy needs the predictions of the corrected state.
     pub fn wants_posterior_predictions(&self) -> bool {
-        matches!(self, Self::Redundant(_))
+        matches!(self, Self::Redundant(_) | Self::Residual(_))
     }
 
-    /// Hands over the measurements with their predictions from the corrected state.
-    pub fn after_update(&mut self, t_s: f64, rows: &[ScalarMeasurement], posterior: &[f64]) {
-        if let Self::Redundant(m) = self {
-            m.after_update(t_s, rows, posterior);
+    /// Hands over the measurements with their predictions from the corrected state and
+    /// their h P̂ hᵀ of the posterior covariance.
+    pub fn after_update(
+        &mut self,
+        t_s: f64,
+        rows: &[ScalarMeasurement],
+        posterior: &[f64],
+        posterior_hph: &[f64],
+    ) {
+        match self {
+            Self::Redundant(m) => m.after_update(t_s, rows, posterior),
+            Self::Residual(m) => m.after_update(t_s, rows, posterior, posterior_hph),
+            Self::Fixed | Self::Innovation(_) => {}
+        }
+    }
+
+    /// The covariance of a receiver fix (loose coupling). Only the residual-based strategy
+    /// estimates it; the others are per-satellite strategies and give `nominal` back.
+    pub fn fix_covariance(&self, nominal: &DMatrix<f64>) -> DMatrix<f64> {
+        match self {
+            Self::Residual(m) => m.fix_covariance(nominal),
+            Self::Fixed | Self::Innovation(_) | Self::Redundant(_) => nominal.clone(),
+        }
+    }
+
+    /// Hands over the post-update residual ε = z − H x̂ of a fix and its H P̂ Hᵀ.
+    pub fn after_fix_update(&mut self, t_s: f64, residual: &DVector<f64>, hph: &DMatrix<f64>) {
+        if let Self::Residual(m) = self {
+            m.after_fix_update(t_s, residual, hph);
         }
     }
 
@@ -116,6 +154,7 @@ impl NoiseModel {
             Self::Fixed => {}
             Self::Innovation(m) => m.reset(),
             Self::Redundant(m) => m.reset(),
+            Self::Residual(m) => m.reset(),
         }
     }
 }

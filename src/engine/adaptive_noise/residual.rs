@@ -1,0 +1,209 @@
+//! The residual-based strategy (`residual_akf`) of Ding, Wang and Rizos (2007, J. Navig.
+//! 60:517), eqs. (14)–(15): R̂ = mean over the last m epochs of ε εᵀ + H P̂ Hᵀ, ε the
+//! post-update residual and P̂ the posterior covariance (see
+//! [`crate::adaptive::residual_r`]).
+//!
+//! Choices:
+//! - Tightly coupled: one scalar estimator per satellite and observable (the satellite set
+//!   changes from epoch to epoch; a joint estimator would restart at every change).
+//!   Loosely coupled: one estimator of the full fix covariance (position, and velocity
+//!   when the fix has one), which keeps the correlations eq. (14) estimates.
+//! - The estimate of the epochs before is used at the current epoch (eq. (14) needs the
+//!   posterior of the epoch itself, so it cannot be used in that epoch's own update); until
+//!   a window is full the nominal R is used. Estimated pseudo-range variances stay within
+//!   the bounds of `adaptive.*`.
+//! - Only measurements seen for the first time teach the estimators (not those re-applied
+//!   after a roll-back), and a satellite unseen for longer than `adaptive.max_epoch_gap_s`
+//!   starts a new window.
+
+use std::collections::HashMap;
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::adaptive::residual_r::{ResidualCovarianceEstimator, ResidualCovarianceOptions};
+use crate::config::Config;
+use crate::gnss::SatId;
+
+use super::{variance_bounds, NoiseVerdict, Observable, ScalarMeasurement};
+
+#[derive(Debug, Clone)]
+struct Track {
+    estimator: ResidualCovarianceEstimator,
+    last_t_s: f64,
+}
+
+/// Residual-based measurement-noise estimation.
+#[derive(Debug, Clone)]
+pub struct ResidualNoise {
+    options: ResidualCovarianceOptions,
+    bounds: [(f64, f64); 2],
+    max_gap_s: f64,
+    tracks: HashMap<(SatId, Observable), Track>,
+    fix: Option<Track>,
+}
+
+impl ResidualNoise {
+    pub fn new(config: &Config) -> Self {
+        let window = config.robust.residual_window_epochs;
+        Self {
+            options: ResidualCovarianceOptions {
+                window,
+                min_samples: window,
+                ..ResidualCovarianceOptions::default()
+            },
+            bounds: [
+                variance_bounds(config, Observable::Pseudorange),
+                variance_bounds(config, Observable::PseudorangeRate),
+            ],
+            max_gap_s: config.adaptive.max_epoch_gap_s,
+            tracks: HashMap::new(),
+            fix: None,
+        }
+    }
+
+    /// The variance of each scalar measurement: the window's estimate when full, else the
+    /// nominal one.
+    pub fn variances(&self, rows: &[ScalarMeasurement]) -> Vec<NoiseVerdict> {
+        rows.iter()
+            .map(|row| {
+                let (lo, hi) = match row.observable {
+                    Observable::Pseudorange => self.bounds[0],
+                    Observable::PseudorangeRate => self.bounds[1],
+                };
+                match self
+                    .tracks
+                    .get(&(row.sat, row.observable))
+                    .and_then(|t| t.estimator.estimate())
+                {
+                    Some(r) => NoiseVerdict {
+                        r: r[(0, 0)].clamp(lo, hi),
+                        estimated: true,
+                        ..NoiseVerdict::nominal(row.r_nominal)
+                    },
+                    None => NoiseVerdict::nominal(row.r_nominal),
+                }
+            })
+            .collect()
+    }
+
+    /// Learns from the measurements of an update at `t_s`: `posterior[i]` is the prediction
+    /// of `rows[i]` from the corrected state (NaN: failed) and `posterior_hph[i]` its
+    /// h P̂ hᵀ.
+    pub fn after_update(
+        &mut self,
+        t_s: f64,
+        rows: &[ScalarMeasurement],
+        posterior: &[f64],
+        posterior_hph: &[f64],
+    ) {
+        for ((row, predicted), hph) in rows.iter().zip(posterior).zip(posterior_hph) {
+            let residual = row.measured - predicted;
+            if !(residual.is_finite() && hph.is_finite()) {
+                continue;
+            }
+            let options = self.options;
+            let track = match self.tracks.entry((row.sat, row.observable)) {
+                std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
+                std::collections::hash_map::Entry::Vacant(e) => {
+                    let Ok(estimator) = ResidualCovarianceEstimator::new(options) else {
+                        continue;
+                    };
+                    e.insert(Track {
+                        estimator,
+                        last_t_s: f64::NEG_INFINITY,
+                    })
+                }
+            };
+            learn(track, t_s, self.max_gap_s, |e| {
+                e.push(
+                    &DVector::from_element(1, residual),
+                    &DMatrix::from_element(1, 1, *hph),
+                )
+            });
+        }
+    }
+
+    /// The covariance of a receiver fix: the window's estimate when full and of the same
+    /// dimension, else `nominal`.
+    pub fn fix_covariance(&self, nominal: &DMatrix<f64>) -> DMatrix<f64> {
+        self.fix
+            .as_ref()
+            .and_then(|t| t.estimator.estimate())
+            .filter(|r| r.nrows() == nominal.nrows())
+            .unwrap_or_else(|| nominal.clone())
+    }
+
+    /// Learns from the post-update residual ε = z − H x̂ of a fix and its H P̂ Hᵀ.
+    pub fn after_fix_update(&mut self, t_s: f64, residual: &DVector<f64>, hph: &DMatrix<f64>) {
+        if self.fix.is_none() {
+            let Ok(estimator) = ResidualCovarianceEstimator::new(self.options) else {
+                return;
+            };
+            self.fix = Some(Track {
+                estimator,
+                last_t_s: f64::NEG_INFINITY,
+            });
+        }
+        if let Some(track) = self.fix.as_mut() {
+            learn(track, t_s, self.max_gap_s, |e| e.push(residual, hph));
+        }
+    }
+
+    pub fn reset(&mut self) {
+        self.tracks.clear();
+        self.fix = None;
+    }
+}
+
+/// Pushes one sample into a track unless `t_s` was already learned; a gap longer than
+/// `max_gap_s` restarts the window first.
+fn learn<F, T, E>(track: &mut Track, t_s: f64, max_gap_s: f64, push: F)
+where
+    F: FnOnce(&mut ResidualCovarianceEstimator) -> Result<T, E>,
+{
+    if t_s <= track.last_t_s {
+        return;
+    }
+    if t_s - track.last_t_s > max_gap_s {
+        track.estimator.reset();
+    }
+    if push(&mut track.estimator).is_ok() {
+        track.last_t_s = t_s;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gnss::Constellation;
+
+    #[test]
+    fn estimate_is_used_after_a_full_window_and_each_epoch_teaches_once() {
+        let mut config = Config::default();
+        config.robust.residual_window_epochs = 5;
+        let mut noise = ResidualNoise::new(&config);
+        let row = ScalarMeasurement {
+            sat: SatId {
+                constellation: Constellation::Gps,
+                prn: 3,
+            },
+            observable: Observable::Pseudorange,
+            measured: 10.0,
+            predicted: 0.0,
+            hph: 1.0,
+            r_nominal: 9.0,
+        };
+        for k in 0..4 {
+            noise.after_update(f64::from(k), &[row], &[8.0], &[0.5]);
+            assert!(!noise.variances(&[row])[0].estimated);
+        }
+        // The same epoch again (a roll-back) does not count.
+        noise.after_update(3.0, &[row], &[8.0], &[0.5]);
+        assert!(!noise.variances(&[row])[0].estimated);
+        noise.after_update(4.0, &[row], &[8.0], &[0.5]);
+        let v = noise.variances(&[row])[0];
+        // ε = 2: ε² + hPh = 4.5.
+        assert!(v.estimated);
+        assert!((v.r - 4.5).abs() < 1e-12);
+    }
+}
