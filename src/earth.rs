@@ -126,42 +126,50 @@ pub fn llh_to_ecef(p: &Llh) -> Vector3<f64> {
     )
 }
 
-/// ECEF (m) to geodetic, by Bowring's method followed by Newton refinement; accurate to
-/// well below a millimetre from the earth's centre region out to GNSS orbit altitudes.
-/// Returns `None` for non-finite input or the earth's centre, where latitude is undefined.
+/// ECEF (m) to geodetic, by Heikkinen's exact closed form (no iteration), followed by
+/// one Newton refinement of the latitude; accurate to well below a millimetre from a few
+/// thousand kilometres from the earth's centre out to GNSS orbit altitudes (a property
+/// test checks the round trip). Returns `None` for non-finite input or points within
+/// 1 km of the earth's centre, where the closed form loses its accuracy.
 pub fn ecef_to_llh(r: &Vector3<f64>) -> Option<Llh> {
-    if !(r[0].is_finite() && r[1].is_finite() && r[2].is_finite()) {
+    if !(r[0].is_finite() && r[1].is_finite() && r[2].is_finite()) || r.norm() < 1e3 {
         return None;
     }
-    let p = r[0].hypot(r[1]);
-    if p < 1e-9 && r[2].abs() < 1e-9 {
-        return None;
-    }
-    let lon = r[1].atan2(r[0]);
     let a = SEMI_MAJOR_AXIS_M;
     let b = SEMI_MINOR_AXIS_M;
+    let e2 = ECCENTRICITY_SQ;
     let ep2 = (a * a - b * b) / (b * b);
-    // Bowring's initial guess, then iterate the exact relation to convergence.
-    let theta = (r[2] * a).atan2(p * b);
-    let (st, ct) = theta.sin_cos();
-    let mut lat = (r[2] + ep2 * b * st.powi(3)).atan2(p - ECCENTRICITY_SQ * a * ct.powi(3));
-    let mut h = 0.0;
-    for _ in 0..5 {
-        let rn = transverse_radius_m(lat);
-        let (sl, cl) = lat.sin_cos();
-        h = if cl.abs() > 1e-3 {
-            p / cl - rn
-        } else {
-            r[2] / sl - rn * (1.0 - ECCENTRICITY_SQ)
-        };
-        let new_lat = r[2].atan2(p * (1.0 - ECCENTRICITY_SQ * rn / (rn + h)));
-        let done = (new_lat - lat).abs() < 1e-14;
-        lat = new_lat;
-        if done {
-            break;
-        }
-    }
-    Some(Llh::new(lat, lon, h))
+    let (x, y, z) = (r[0], r[1], r[2]);
+    let p = x.hypot(y);
+    let f = 54.0 * b * b * z * z;
+    let g = p * p + (1.0 - e2) * z * z - e2 * (a * a - b * b);
+    let c = e2 * e2 * f * p * p / (g * g * g);
+    let s = (1.0 + c + (c * c + 2.0 * c).sqrt()).cbrt();
+    let k = s + 1.0 + 1.0 / s;
+    let big_p = f / (3.0 * k * k * g * g);
+    let q = (1.0 + 2.0 * e2 * e2 * big_p).sqrt();
+    let r0 = -big_p * e2 * p / (1.0 + q)
+        + (0.5 * a * a * (1.0 + 1.0 / q)
+            - big_p * (1.0 - e2) * z * z / (q * (1.0 + q))
+            - 0.5 * big_p * p * p)
+            .max(0.0)
+            .sqrt();
+    let v = ((p - e2 * r0).powi(2) + (1.0 - e2) * z * z).sqrt();
+    let z0 = b * b * z / (a * v);
+    let closed_form_lat = (z + ep2 * z0).atan2(p);
+    // One refinement on the exact relations (it removes the closed form's rounding at
+    // large heights): the height at the closed-form latitude, then the latitude.
+    let rn = transverse_radius_m(closed_form_lat);
+    let (sl, cl) = closed_form_lat.sin_cos();
+    let h = if cl.abs() > sl.abs() {
+        p / cl - rn
+    } else {
+        z / sl - rn * (1.0 - e2)
+    };
+    let lat = z.atan2(p * (1.0 - e2 * rn / (rn + h)));
+    let lon = y.atan2(x);
+    let llh = Llh::new(lat, lon, h);
+    llh.is_finite().then_some(llh)
 }
 
 /// Rotation from ECEF to local ENU at `p`: v_enu = C_en · v_ecef.
