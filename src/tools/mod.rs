@@ -5,5 +5,6 @@ pub mod bag_inputs;
 pub mod cli;
 pub mod compare;
 pub mod replay;
+pub mod scenario_inputs;
 pub mod session;
 pub mod simulate;

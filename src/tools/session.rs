@@ -3,7 +3,7 @@
 
 use std::collections::{BTreeMap, HashMap};
 
-use crate::config::Config;
+use crate::config::{Config, Coupling};
 use crate::engine::{Engine, EpochReport, GnssFix, InputRejected, Output, Solution};
 use crate::eval::{self, ErrorSummary, SolutionError, TruthSample, TruthTrack};
 use crate::gnss::{GnssEpoch, SatId};
@@ -128,12 +128,15 @@ impl Session {
         &self.engine
     }
 
-    /// Feeds one input; returns the engine's outputs (for writing).
+    /// Feeds one input; returns the engine's outputs (for writing). Measurements of the
+    /// other coupling (fixes when tightly coupled, raw epochs when loosely) are not used.
     pub fn push(&mut self, input: SessionInput) -> Vec<Output> {
+        let coupling = self.engine.config().filter.coupling;
         let result = match input {
             SessionInput::Imu(s) => self.engine.push_imu(&s),
-            SessionInput::Gnss(e) => self.engine.push_gnss(e),
-            SessionInput::Fix(f) => self.engine.push_fix(f),
+            SessionInput::Gnss(e) if coupling == Coupling::Tight => self.engine.push_gnss(e),
+            SessionInput::Fix(f) if coupling == Coupling::Loose => self.engine.push_fix(f),
+            SessionInput::Gnss(_) | SessionInput::Fix(_) => return Vec::new(),
             SessionInput::Truth(t) => {
                 self.score_streamed(&t);
                 return Vec::new();

@@ -1,0 +1,83 @@
+//! The ERMAKF paper's field comparison on the default simulated scenario (a drive with
+//! foliage over 40–120 s and dense buildings over 260–320 s): EKF, EIAKF, SRMAKF and
+//! ERMAKF on the same data. The paper's Table 1 reports 3D errors of 5.52/6.24/6.12/4.60 m
+//! (position) and 0.38/0.29/0.38/0.17 m/s (velocity) for EKF/EIAKF/SRMAKF/ERMAKF.
+//!
+//! Asserted, as the paper claims: ERMAKF beats the standard EKF on 3D position and
+//! velocity RMSE (measured: 4.744 against 5.946 m, 0.2847 against 0.2957 m/s).
+//!
+//! Not reproduced (the ignored test keeps the paper's claim as an executable check): in
+//! the foliage segment ERMAKF's estimated pseudo-range σ is NOT closer to the simulator's
+//! true σ than SRMAKF's (RMS error 2.293 m against 2.172 m; EKF's fixed σ 2.875 m). The
+//! simulated multipath is AR(2) with lag-1 correlation about 0.94: the mutual difference
+//! ∇Z keeps only 1 − ρ₁ of its variance, and eq. (29) applied to ∇Z restores little of it
+//! (its factor 1 − Σ aᵢβᵢ is the one-step predictability of ∇Z, not of the noise itself).
+//! SRMAKF also has the lower position error here (4.484 m).
+
+use adaptive_gnss_ins::config::{Config, FilterVariant};
+use adaptive_gnss_ins::sim::Scenario;
+use adaptive_gnss_ins::tools::scenario_inputs::scenario_inputs;
+use adaptive_gnss_ins::tools::session::{Session, SessionReport};
+
+/// The scenario's seed (fixed: the comparison is one realization, as the paper's).
+const SEED: u64 = 1;
+
+fn run(variant: FilterVariant) -> SessionReport {
+    let scenario = Scenario::builtin("default", SEED).unwrap();
+    let mut config = Config::default();
+    config.filter.variant = variant;
+    let mut session = Session::new(config, 0.0, None);
+    for input in scenario_inputs(&scenario) {
+        session.push(input.unwrap());
+    }
+    session.finish()
+}
+
+#[test]
+fn ermakf_family_on_the_default_scenario() {
+    let variants = [
+        FilterVariant::Ekf,
+        FilterVariant::Eiakf,
+        FilterVariant::Srmakf,
+        FilterVariant::Ermakf,
+    ];
+    let mut rows = Vec::new();
+    for v in variants {
+        let report = run(v);
+        let s = report.summary(f64::NEG_INFINITY);
+        let foliage_sigma = report.sigma_rms_error_m("foliage");
+        println!(
+            "{:<7} pos3d {:.3} m  vel3d {:.4} m/s  yaw {:.3} deg  NEES {:.1}  \
+             foliage sigma RMS error {:.3} m",
+            v.as_str(),
+            s.pos_rmse_3d_m,
+            s.vel_rmse_3d_mps,
+            s.att_rmse_yaw_deg,
+            s.nees_mean,
+            foliage_sigma
+        );
+        assert!(s.epochs > 3000, "{} scored epochs", s.epochs);
+        rows.push((v, s, foliage_sigma));
+    }
+    let get = |v: FilterVariant| rows.iter().find(|r| r.0 == v).unwrap();
+    let (ekf, ermakf, srmakf) = (
+        get(FilterVariant::Ekf),
+        get(FilterVariant::Ermakf),
+        get(FilterVariant::Srmakf),
+    );
+    assert!(ermakf.1.pos_rmse_3d_m < ekf.1.pos_rmse_3d_m);
+    assert!(ermakf.1.vel_rmse_3d_mps < ekf.1.vel_rmse_3d_mps);
+    // Every adaptive estimate tracks the foliage noise better than the fixed model.
+    assert!(srmakf.2 < ekf.2 && ermakf.2 < ekf.2);
+}
+
+#[test]
+#[ignore = "the paper's claim does not reproduce here; see the module documentation"]
+fn ermakf_sigma_is_closer_to_the_truth_in_foliage_than_srmakf() {
+    let ermakf = run(FilterVariant::Ermakf).sigma_rms_error_m("foliage");
+    let srmakf = run(FilterVariant::Srmakf).sigma_rms_error_m("foliage");
+    assert!(
+        ermakf < srmakf,
+        "foliage σ error: ermakf {ermakf} m, srmakf {srmakf} m"
+    );
+}
