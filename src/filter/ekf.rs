@@ -91,7 +91,7 @@ pub fn update(
     let nis = y.dot(&chol.solve(y));
     let i_kh = DMatrix::<f64>::identity(N, N) - &k * h;
     let p_post = if joseph {
-        &i_kh * &p_dyn * i_kh.transpose() + &k * r * k.transpose()
+        &i_kh * &p_dyn * i_kh.transpose() + k_r_kt(&k, r)
     } else {
         &i_kh * &p_dyn
     };
@@ -110,6 +110,22 @@ pub fn update(
         s,
         nis,
     })
+}
+
+/// K R Kᵀ, with R's columns applied as a scaling when R is diagonal (the usual case of
+/// independent satellites), which saves a dense product.
+fn k_r_kt(k: &DMatrix<f64>, r: &DMatrix<f64>) -> DMatrix<f64> {
+    let m = r.nrows();
+    let diagonal = (0..m).all(|i| (0..m).all(|j| i == j || r[(i, j)] == 0.0));
+    if diagonal {
+        let mut kr = k.clone();
+        for (j, mut column) in kr.column_iter_mut().enumerate() {
+            column *= r[(j, j)];
+        }
+        kr * k.transpose()
+    } else {
+        k * r * k.transpose()
+    }
 }
 
 #[cfg(test)]
@@ -133,6 +149,19 @@ mod tests {
             assert!((u.p[(0, 0)] - 0.8).abs() < 1e-12);
             assert!((u.p[(1, 1)] - (4.0 - 0.2)).abs() < 1e-12);
             assert!((u.nis - 0.8).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn k_r_kt_with_diagonal_and_full_r_agree_with_the_dense_product() {
+        let k = DMatrix::from_fn(4, 3, |i, j| (i as f64 + 1.0) * 0.3 - j as f64 * 0.7);
+        let diag = DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![2.0, 0.5, 3.0]));
+        let mut full = diag.clone();
+        full[(0, 2)] = 0.4;
+        full[(2, 0)] = 0.4;
+        for r in [diag, full] {
+            let dense = &k * &r * k.transpose();
+            assert!((k_r_kt(&k, &r) - dense).amax() < 1e-12);
         }
     }
 
