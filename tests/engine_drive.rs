@@ -11,11 +11,14 @@ use adaptive_gnss_ins::eval;
 use adaptive_gnss_ins::sim::constellation::{
     AtmosphereTruth, GpsConstellation, ObservationNoise, ReceiverTruth,
 };
-use adaptive_gnss_ins::sim::{ImuErrorModel, ImuErrorSpec, Segment, Trajectory, TrajectorySpec};
+use adaptive_gnss_ins::sim::{ImuErrorModel, ImuErrorSpec, Trajectory};
+
+mod support;
 use rand_chacha::rand_core::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 use statrs::distribution::{ChiSquared, ContinuousCDF};
+use support::drive::drive;
 
 /// Horizontal and vertical position RMSE budgets after convergence (m): with about nine
 /// satellites at 3 m zenith σ, single-epoch positions scatter by about 1.5 m horizontally
@@ -30,68 +33,6 @@ const MAX_ROLL_PITCH_RMSE_DEG: f64 = 0.1;
 const MAX_YAW_RMSE_DEG: f64 = 0.5;
 /// Scoring starts after the start-up and this settling time (s).
 const SETTLING_S: f64 = 60.0;
-
-fn drive() -> TrajectorySpec {
-    use Segment::*;
-    TrajectorySpec {
-        start_t_s: 0.0,
-        start_lat_deg: 39.1,
-        start_lon_deg: 117.2,
-        start_height_m: 20.0,
-        start_yaw_deg: 30.0,
-        start_speed_m_s: 0.0,
-        transition_s: 2.0,
-        segments: vec![
-            Stationary { duration_s: 10.0 },
-            SpeedTo {
-                duration_s: 12.0,
-                speed_m_s: 12.0,
-            },
-            Cruise { duration_s: 30.0 },
-            Turn {
-                duration_s: 10.0,
-                yaw_change_deg: 90.0,
-            },
-            Cruise { duration_s: 20.0 },
-            Climb {
-                duration_s: 20.0,
-                climb_angle_deg: 4.0,
-            },
-            Climb {
-                duration_s: 20.0,
-                climb_angle_deg: -4.0,
-            },
-            SpeedTo {
-                duration_s: 10.0,
-                speed_m_s: 18.0,
-            },
-            Turn {
-                duration_s: 12.0,
-                yaw_change_deg: -120.0,
-            },
-            Cruise { duration_s: 30.0 },
-            SpeedTo {
-                duration_s: 10.0,
-                speed_m_s: 0.0,
-            },
-            Stationary { duration_s: 10.0 },
-            SpeedTo {
-                duration_s: 10.0,
-                speed_m_s: 10.0,
-            },
-            Turn {
-                duration_s: 15.0,
-                yaw_change_deg: 180.0,
-            },
-            Cruise { duration_s: 40.0 },
-            Turn {
-                duration_s: 10.0,
-                yaw_change_deg: 60.0,
-            },
-            Cruise { duration_s: 30.0 },
-        ],
-    }
-}
 
 fn rms(values: impl Iterator<Item = f64>) -> f64 {
     let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v * v, n + 1));
@@ -167,7 +108,7 @@ fn adaptive_variants_on_an_open_sky_drive() {
 }
 
 fn run_drive(config: Config) -> Metrics {
-    let trajectory = Trajectory::new(&drive()).unwrap();
+    let trajectory = Trajectory::new(&drive(1)).unwrap();
     let imu_rate_hz = 100.0;
     let mut imu_errors = ImuErrorModel::new(&ImuErrorSpec::default(), imu_rate_hz, 42).unwrap();
     let constellation = GpsConstellation::augmented(1);

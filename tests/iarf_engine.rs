@@ -17,11 +17,14 @@ use adaptive_gnss_ins::engine::{Engine, EpochReport, GnssFix, Output, StatusEven
 use adaptive_gnss_ins::sim::constellation::{
     AtmosphereTruth, GpsConstellation, ObservationNoise, ReceiverTruth,
 };
-use adaptive_gnss_ins::sim::{ImuErrorModel, ImuErrorSpec, Segment, Trajectory, TrajectorySpec};
+use adaptive_gnss_ins::sim::{ImuErrorModel, ImuErrorSpec, Trajectory};
+
+mod support;
 use nalgebra::Vector3;
 use rand_chacha::rand_core::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal, Uniform};
+use support::drive::drive;
 
 /// Scoring starts this long after the start-up (s).
 const SETTLING_S: f64 = 60.0;
@@ -32,77 +35,6 @@ const FIX_VELOCITY_SIGMA_MPS: f64 = 0.05;
 const OUTLIER_RATE: f64 = 0.05;
 const OUTLIER_MIN_M: f64 = 3.0;
 const OUTLIER_MAX_M: f64 = 10.0;
-
-/// The open-sky drive of tests/engine_drive.rs, its moving part repeated `laps` times.
-fn drive(laps: usize) -> TrajectorySpec {
-    use Segment::*;
-    let lap = vec![
-        SpeedTo {
-            duration_s: 12.0,
-            speed_m_s: 12.0,
-        },
-        Cruise { duration_s: 30.0 },
-        Turn {
-            duration_s: 10.0,
-            yaw_change_deg: 90.0,
-        },
-        Cruise { duration_s: 20.0 },
-        Climb {
-            duration_s: 20.0,
-            climb_angle_deg: 4.0,
-        },
-        Climb {
-            duration_s: 20.0,
-            climb_angle_deg: -4.0,
-        },
-        SpeedTo {
-            duration_s: 10.0,
-            speed_m_s: 18.0,
-        },
-        Turn {
-            duration_s: 12.0,
-            yaw_change_deg: -120.0,
-        },
-        Cruise { duration_s: 30.0 },
-        SpeedTo {
-            duration_s: 10.0,
-            speed_m_s: 0.0,
-        },
-        Stationary { duration_s: 10.0 },
-        SpeedTo {
-            duration_s: 10.0,
-            speed_m_s: 10.0,
-        },
-        Turn {
-            duration_s: 15.0,
-            yaw_change_deg: 180.0,
-        },
-        Cruise { duration_s: 40.0 },
-        Turn {
-            duration_s: 10.0,
-            yaw_change_deg: 60.0,
-        },
-        Cruise { duration_s: 30.0 },
-        SpeedTo {
-            duration_s: 10.0,
-            speed_m_s: 0.0,
-        },
-    ];
-    let mut segments = vec![Stationary { duration_s: 10.0 }];
-    for _ in 0..laps {
-        segments.extend(lap.iter().cloned());
-    }
-    TrajectorySpec {
-        start_t_s: 0.0,
-        start_lat_deg: 39.1,
-        start_lon_deg: 117.2,
-        start_height_m: 20.0,
-        start_yaw_deg: 30.0,
-        start_speed_m_s: 0.0,
-        transition_s: 2.0,
-        segments,
-    }
-}
 
 /// What one run measured.
 #[derive(Debug, Default)]

@@ -2,6 +2,8 @@
 //! simulated GPS pseudo-ranges with white noise of the filter's own σ model.
 #![allow(dead_code)]
 
+pub mod drive;
+
 use adaptive_gnss_ins::config::Config;
 use adaptive_gnss_ins::earth::{self, Llh};
 use adaptive_gnss_ins::gnss::GnssEpoch;
