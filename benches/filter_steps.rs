@@ -2,7 +2,7 @@
 //! propagation) and one tightly-coupled update with 12 satellites (24 measurements).
 //! Run with `cargo bench --bench filter_steps`; the README reports the numbers.
 
-use adaptive_gnss_ins::config::Config;
+use adaptive_gnss_ins::config::{Config, FilterVariant};
 use adaptive_gnss_ins::earth::{self, Llh};
 use adaptive_gnss_ins::engine::{process_noise, tight_update, Adaptation, FilterState};
 use adaptive_gnss_ins::gnss::GnssEpoch;
@@ -109,5 +109,102 @@ fn tc_update(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, imu_step, tc_update);
+/// Noisy epochs of a static receiver, one per second.
+fn noisy_epochs(p: &Llh, count: usize) -> Vec<GnssEpoch> {
+    use rand_chacha::rand_core::SeedableRng;
+    use rand_distr::{Distribution, Normal};
+    let constellation = GpsConstellation::augmented(2);
+    let atmosphere = AtmosphereTruth {
+        report_delays: true,
+        ..AtmosphereTruth::vacuum()
+    };
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+    let unit = Normal::new(0.0, 1.0).expect("unit normal");
+    let t0 = first_time_with_12(&constellation, p);
+    (0..count)
+        .map(|k| {
+            let t = t0 + k as f64;
+            let rx = ReceiverTruth {
+                pos_ecef_m: earth::llh_to_ecef(p),
+                vel_ecef_mps: Vector3::zeros(),
+                clock_bias_m: 100.0 + t,
+                clock_drift_mps: 1.0,
+            };
+            let mut noise = |_| ObservationNoise {
+                pseudorange_m: 3.0 * unit.sample(&mut rng),
+                pseudorange_rate_mps: 0.1 * unit.sample(&mut rng),
+            };
+            let mut e = constellation
+                .simulate_epoch(t, &rx, &atmosphere, 5f64.to_radians(), &mut noise)
+                .expect("simulated epoch");
+            e.satellites.truncate(12);
+            e
+        })
+        .collect()
+}
+
+fn first_time_with_12(constellation: &GpsConstellation, p: &Llh) -> f64 {
+    let rx = ReceiverTruth {
+        pos_ecef_m: earth::llh_to_ecef(p),
+        vel_ecef_mps: Vector3::zeros(),
+        clock_bias_m: 0.0,
+        clock_drift_mps: 0.0,
+    };
+    let atmosphere = AtmosphereTruth::vacuum();
+    (0..1440)
+        .map(|minute| minute as f64 * 60.0)
+        .find(|&t| {
+            constellation
+                .simulate_epoch(t, &rx, &atmosphere, 5f64.to_radians(), |_| {
+                    ObservationNoise::default()
+                })
+                .is_ok_and(|e| e.satellites.len() >= 14)
+        })
+        .expect("a time with 14 satellites in view")
+}
+
+/// The cost of one epoch in steady state (windows full, M = 100) for the plain EKF and the
+/// adaptive variants: the difference is the adaptive step's added cost.
+fn tc_update_adaptive(c: &mut Criterion) {
+    let p = Llh::from_degrees(39.1, 117.2, 20.0);
+    let epochs = noisy_epochs(&p, 2000);
+    let w = Vector3::zeros();
+    for variant in [
+        FilterVariant::Ekf,
+        FilterVariant::Srmakf,
+        FilterVariant::Ermakf,
+    ] {
+        let mut config = Config::default();
+        config.filter.variant = variant;
+        config.gnss.elevation_mask_rad = 5f64.to_radians();
+        let mut state = running_state(p);
+        let mut adaptation = Adaptation::new(&config);
+        // Warm up: fill every window.
+        for e in &epochs[..150] {
+            tight_update::update(&mut state, e, &w, &config, &mut adaptation, true)
+                .expect("update");
+        }
+        let mut k = 150usize;
+        let name = format!("tc_epoch_12_satellites_{}", variant.as_str());
+        c.bench_function(&name, |b| {
+            b.iter(|| {
+                let laps = (k / epochs.len()) as f64;
+                let mut e = epochs[k % epochs.len()].clone();
+                e.t_s += laps * epochs.len() as f64;
+                k += 1;
+                tight_update::update(
+                    &mut state,
+                    black_box(&e),
+                    &w,
+                    &config,
+                    &mut adaptation,
+                    true,
+                )
+                .expect("update")
+            })
+        });
+    }
+}
+
+criterion_group!(benches, imu_step, tc_update, tc_update_adaptive);
 criterion_main!(benches);
