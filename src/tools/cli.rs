@@ -149,7 +149,22 @@ pub fn run(command: Command) -> Result<(), String> {
                 );
             }
             if result.report.solutions == 0 {
-                return Err("no solution: nothing usable in the bag".to_owned());
+                let used: Vec<String> = result
+                    .problems
+                    .used_topics
+                    .iter()
+                    .map(|(topic, n)| format!("{n} on {topic}"))
+                    .collect();
+                return Err(format!(
+                    "{}: no solution, nothing usable in the bag (messages used: {}); the \
+                     engine needs IMU samples and GNSS measurements or fixes to start",
+                    bag.display(),
+                    if used.is_empty() {
+                        "none".to_owned()
+                    } else {
+                        used.join(", ")
+                    }
+                ));
             }
             Ok(())
         }
@@ -194,6 +209,12 @@ fn progress_bar(fraction: f64) -> String {
 }
 
 fn print_problems(problems: &super::bag_inputs::ReadProblems, report: &SessionReport) {
+    for (what, n) in &problems.unused_topics {
+        eprintln!("ignored {n} messages on a topic this run does not use: {what}");
+    }
+    for (what, n) in &problems.wrong_types {
+        eprintln!("skipped {n} messages of an unexpected type: {what}");
+    }
     for (what, n) in &problems.undecodable {
         eprintln!("skipped {n} undecodable messages ({what})");
     }
