@@ -48,15 +48,55 @@ impl Default for BagTopics {
     }
 }
 
-/// What was skipped while reading.
+/// What was read and what was skipped while reading.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct ReadProblems {
-    /// Messages on topics this run does not use, by topic.
+    /// Messages used (decoded and handed on, or the datum), by topic.
+    pub used_topics: BTreeMap<String, u64>,
+    /// Messages on topics this run does not use, by "topic (type)".
     pub unused_topics: BTreeMap<String, u64>,
-    /// Messages that did not decode or convert, by topic and reason.
+    /// Messages on a topic this run uses but of another type, by "topic: type, expected
+    /// type".
+    pub wrong_types: BTreeMap<String, u64>,
+    /// Messages that did not decode or convert, by "topic: reason".
     pub undecodable: BTreeMap<String, u64>,
     /// Errors of the bag itself (corrupt chunks, truncation).
     pub bag_errors: Vec<String>,
+}
+
+impl ReadProblems {
+    /// Messages used on `topic`.
+    pub fn used(&self, topic: &str) -> u64 {
+        self.used_topics.get(topic).copied().unwrap_or(0)
+    }
+
+    /// Messages skipped for any reason (bag errors are not messages and not counted).
+    pub fn skipped(&self) -> u64 {
+        self.unused_topics.values().sum::<u64>()
+            + self.wrong_types.values().sum::<u64>()
+            + self.undecodable.values().sum::<u64>()
+    }
+}
+
+impl BagTopics {
+    /// The message type this run expects on `topic`, if it uses the topic.
+    pub fn expected_type(&self, topic: &str) -> Option<&'static str> {
+        if topic == self.imu {
+            Some(Imu::TYPE_NAME)
+        } else if topic == self.gnss {
+            Some(GnssMeasurements::TYPE_NAME)
+        } else if topic == self.fix || topic == self.truth_datum {
+            Some(NavSatFix::TYPE_NAME)
+        } else if self.truth.as_deref() == Some(topic) {
+            Some(Odometry::TYPE_NAME)
+        } else if topic == self.truth_noise {
+            Some(NoiseEstimates::TYPE_NAME)
+        } else if topic == self.environment {
+            Some(DiagnosticArray::TYPE_NAME)
+        } else {
+            None
+        }
+    }
 }
 
 /// The iterator of inputs over a bag's messages.
@@ -81,66 +121,90 @@ impl BagInputs {
         &self.problems
     }
 
-    fn undecodable(&mut self, topic: &str, reason: &str) {
-        *self
-            .problems
-            .undecodable
-            .entry(format!("{topic}: {reason}"))
-            .or_insert(0) += 1;
+    /// Counts one message of `topic` in `map` under `key`.
+    fn count(map: &mut BTreeMap<String, u64>, key: String) {
+        *map.entry(key).or_insert(0) += 1;
     }
 
-    fn decode<T: RosMessage>(&mut self, topic: &str, data: &[u8]) -> Option<T> {
-        match cdr::decode::<T>(data) {
-            Ok(m) => Some(m),
-            Err(e) => {
-                self.undecodable(topic, &e.to_string());
+    /// The input of one message; counts it as used or skipped (with the reason).
+    fn convert(&mut self, topic: &str, type_name: &str, data: &[u8]) -> Option<SessionInput> {
+        let problems = &mut self.problems;
+        match self.topics.expected_type(topic) {
+            None => {
+                Self::count(
+                    &mut problems.unused_topics,
+                    format!("{topic} ({type_name})"),
+                );
                 None
             }
+            Some(expected) if expected != type_name => {
+                Self::count(
+                    &mut problems.wrong_types,
+                    format!("{topic}: {type_name}, expected {expected}"),
+                );
+                None
+            }
+            Some(_) => match self.convert_known(topic, data) {
+                Ok(input) => {
+                    // Choice: the count lookup by &str first avoids an allocation per
+                    // message on the hot path (hundreds of thousands of IMU samples).
+                    match self.problems.used_topics.get_mut(topic) {
+                        Some(n) => *n += 1,
+                        None => {
+                            self.problems.used_topics.insert(topic.to_owned(), 1);
+                        }
+                    }
+                    input
+                }
+                Err(reason) => {
+                    Self::count(&mut self.problems.undecodable, format!("{topic}: {reason}"));
+                    None
+                }
+            },
         }
     }
 
-    fn convert(&mut self, topic: &str, type_name: &str, data: &[u8]) -> Option<SessionInput> {
+    /// The input of a message of the expected type on a topic this run uses: None for a
+    /// message that is used without giving an input (the datum, a fix without solution),
+    /// Err with the reason for one that does not decode or convert.
+    fn convert_known(&mut self, topic: &str, data: &[u8]) -> Result<Option<SessionInput>, String> {
         let t = &self.topics;
-        if topic == t.imu && type_name == Imu::TYPE_NAME {
-            let msg: Imu = self.decode(topic, data)?;
-            return match ImuSample::try_from(&msg) {
-                Ok(s) => Some(SessionInput::Imu(s)),
-                Err(e) => {
-                    self.undecodable(topic, &e.to_string());
-                    None
-                }
-            };
+        let stamp = |s: &crate::ros::msg::Time| time_to_seconds(s).map_err(|e| e.to_string());
+        if topic == t.imu {
+            let msg: Imu = decode(data)?;
+            let sample = ImuSample::try_from(&msg).map_err(|e| e.to_string())?;
+            return Ok(Some(SessionInput::Imu(sample)));
         }
-        if topic == t.gnss && type_name == GnssMeasurements::TYPE_NAME {
-            let msg: GnssMeasurements = self.decode(topic, data)?;
-            return match GnssEpoch::try_from(&msg) {
-                Ok(e) => Some(SessionInput::Gnss(e)),
-                Err(e) => {
-                    self.undecodable(topic, &e.to_string());
-                    None
-                }
-            };
+        if topic == t.gnss {
+            let msg: GnssMeasurements = decode(data)?;
+            let epoch = GnssEpoch::try_from(&msg).map_err(|e| e.to_string())?;
+            return Ok(Some(SessionInput::Gnss(epoch)));
         }
-        if topic == t.fix && type_name == NavSatFix::TYPE_NAME {
-            let msg: NavSatFix = self.decode(topic, data)?;
-            return fix_of(&msg).map(SessionInput::Fix);
+        if topic == t.fix {
+            let msg: NavSatFix = decode(data)?;
+            if msg.status.status < 0 {
+                return Ok(None);
+            }
+            return Ok(Some(SessionInput::Fix(fix_of(
+                &msg,
+                stamp(&msg.header.stamp)?,
+            ))));
         }
-        if topic == t.truth_datum && type_name == NavSatFix::TYPE_NAME {
-            let msg: NavSatFix = self.decode(topic, data)?;
+        if topic == t.truth_datum {
+            let msg: NavSatFix = decode(data)?;
             self.datum = Some(Llh::from_degrees(msg.latitude, msg.longitude, msg.altitude));
-            return None;
+            return Ok(None);
         }
-        if t.truth.as_deref() == Some(topic) && type_name == Odometry::TYPE_NAME {
-            let msg: Odometry = self.decode(topic, data)?;
-            let Some(datum) = self.datum else {
-                self.undecodable(topic, "reference before its datum");
-                return None;
-            };
-            return truth_of(&msg, &datum).map(SessionInput::Truth);
+        if t.truth.as_deref() == Some(topic) {
+            let msg: Odometry = decode(data)?;
+            let datum = self.datum.ok_or("reference before its datum")?;
+            let t_s = stamp(&msg.header.stamp)?;
+            let truth = truth_of(&msg, t_s, &datum).ok_or("reference position out of range")?;
+            return Ok(Some(SessionInput::Truth(truth)));
         }
-        if topic == t.truth_noise && type_name == NoiseEstimates::TYPE_NAME {
-            let msg: NoiseEstimates = self.decode(topic, data)?;
-            let t_s = time_to_seconds(&msg.header.stamp).ok()?;
+        if topic == t.truth_noise {
+            let msg: NoiseEstimates = decode(data)?;
+            let t_s = stamp(&msg.header.stamp)?;
             let sigmas = msg
                 .satellites
                 .iter()
@@ -156,21 +220,26 @@ impl BagInputs {
                     ))
                 })
                 .collect();
-            return Some(SessionInput::TruthSigmas { t_s, sigmas });
+            return Ok(Some(SessionInput::TruthSigmas { t_s, sigmas }));
         }
-        if topic == t.environment && type_name == DiagnosticArray::TYPE_NAME {
-            let msg: DiagnosticArray = self.decode(topic, data)?;
-            let t_s = time_to_seconds(&msg.header.stamp).ok()?;
-            let name = msg.status.first()?.message.clone();
-            return Some(SessionInput::Environment { t_s, name });
+        if topic == t.environment {
+            let msg: DiagnosticArray = decode(data)?;
+            let t_s = stamp(&msg.header.stamp)?;
+            let name = msg
+                .status
+                .first()
+                .ok_or("environment without status")?
+                .message
+                .clone();
+            return Ok(Some(SessionInput::Environment { t_s, name }));
         }
-        *self
-            .problems
-            .unused_topics
-            .entry(topic.to_owned())
-            .or_insert(0) += 1;
-        None
+        Ok(None)
     }
+}
+
+/// Decodes CDR, the error as text.
+fn decode<T: RosMessage>(data: &[u8]) -> Result<T, String> {
+    cdr::decode::<T>(data).map_err(|e| e.to_string())
 }
 
 impl Iterator for BagInputs {
@@ -190,27 +259,23 @@ impl Iterator for BagInputs {
     }
 }
 
-/// A receiver fix from NavSatFix (a fix without a solution is skipped).
-fn fix_of(msg: &NavSatFix) -> Option<GnssFix> {
-    if msg.status.status < 0 {
-        return None;
-    }
-    let t_s = time_to_seconds(&msg.header.stamp).ok()?;
+/// A receiver fix from a NavSatFix with a solution, stamped `t_s`.
+fn fix_of(msg: &NavSatFix, t_s: f64) -> GnssFix {
     let c = &msg.position_covariance;
     let covariance = (msg.position_covariance_type != NavSatFix::COVARIANCE_TYPE_UNKNOWN)
         .then(|| Matrix3::from_fn(|r, k| c[3 * r + k]));
-    Some(GnssFix {
+    GnssFix {
         t_s,
         position: Llh::from_degrees(msg.latitude, msg.longitude, msg.altitude),
         position_covariance_enu_m2: covariance,
         velocity_enu_mps: None,
         velocity_covariance_enu_m2_s2: None,
-    })
+    }
 }
 
-/// A reference sample from Odometry in the ENU frame at `datum`.
-fn truth_of(msg: &Odometry, datum: &Llh) -> Option<TruthSample> {
-    let t_s = time_to_seconds(&msg.header.stamp).ok()?;
+/// A reference sample at `t_s` from Odometry in the ENU frame at `datum` (None when the
+/// position does not convert).
+fn truth_of(msg: &Odometry, t_s: f64, datum: &Llh) -> Option<TruthSample> {
     let p = &msg.pose.pose.position;
     let llh = earth::enu_to_llh(&nalgebra::Vector3::new(p.x, p.y, p.z), datum)?;
     let o = &msg.pose.pose.orientation;

@@ -10,6 +10,7 @@ use crate::config::{Config, FilterVariant};
 use crate::sim::{Scenario, ScenarioSpec};
 
 use super::compare::{format_csv, format_table, ComparisonRow};
+use super::plots::{write_plots, FilterRun};
 use super::replay::{self, ReplayOptions, TruthSource};
 use super::session::{Session, SessionReport};
 use super::simulate::{self, TRUTH_TOPIC};
@@ -61,6 +62,10 @@ pub enum Command {
         params_dir: Option<PathBuf>,
         #[arg(long, value_enum, default_value_t = Format::Table)]
         format: Format,
+        /// Folder for PNG and SVG figures of the errors over time and of the estimated
+        /// against the true noise σ.
+        #[arg(long)]
+        plots: Option<PathBuf>,
     },
     /// Simulate the default scenario into a temporary folder and compare every variant.
     Demo {
@@ -149,7 +154,22 @@ pub fn run(command: Command) -> Result<(), String> {
                 );
             }
             if result.report.solutions == 0 {
-                return Err("no solution: nothing usable in the bag".to_owned());
+                let used: Vec<String> = result
+                    .problems
+                    .used_topics
+                    .iter()
+                    .map(|(topic, n)| format!("{n} on {topic}"))
+                    .collect();
+                return Err(format!(
+                    "{}: no solution, nothing usable in the bag (messages used: {}); the \
+                     engine needs IMU samples and GNSS measurements or fixes to start",
+                    bag.display(),
+                    if used.is_empty() {
+                        "none".to_owned()
+                    } else {
+                        used.join(", ")
+                    }
+                ));
             }
             Ok(())
         }
@@ -158,9 +178,22 @@ pub fn run(command: Command) -> Result<(), String> {
             filters,
             params_dir,
             format,
+            plots,
         } => {
-            let rows = compare_bag(&bag, &filters, params_dir.as_deref())?;
+            let runs = compare_bag(&bag, &filters, params_dir.as_deref())?;
+            let rows: Vec<ComparisonRow> = runs.iter().map(|(row, _)| row.clone()).collect();
             print!("{}", render(&rows, format)?);
+            if let Some(dir) = plots {
+                let runs: Vec<FilterRun> = runs
+                    .into_iter()
+                    .map(|(row, report)| FilterRun {
+                        name: row.filter,
+                        report,
+                    })
+                    .collect();
+                let files = write_plots(&dir, &runs).map_err(|e| e.to_string())?;
+                eprintln!("wrote {} figures into {}", files.len(), dir.display());
+            }
             Ok(())
         }
         Command::Demo { seed } => {
@@ -175,7 +208,8 @@ pub fn run(command: Command) -> Result<(), String> {
                 bag.display(),
                 scenario.duration_s()
             );
-            let rows = compare_bag(&bag, &[], None)?;
+            let runs = compare_bag(&bag, &[], None)?;
+            let rows: Vec<ComparisonRow> = runs.into_iter().map(|(row, _)| row).collect();
             print!("{}", format_table(&rows));
             Ok(())
         }
@@ -194,6 +228,12 @@ fn progress_bar(fraction: f64) -> String {
 }
 
 fn print_problems(problems: &super::bag_inputs::ReadProblems, report: &SessionReport) {
+    for (what, n) in &problems.unused_topics {
+        eprintln!("ignored {n} messages on a topic this run does not use: {what}");
+    }
+    for (what, n) in &problems.wrong_types {
+        eprintln!("skipped {n} messages of an unexpected type: {what}");
+    }
     for (what, n) in &problems.undecodable {
         eprintln!("skipped {n} undecodable messages ({what})");
     }
@@ -253,12 +293,12 @@ fn variant_config(name: &str, params_dir: Option<&Path>) -> Result<Config, Strin
     Ok(config)
 }
 
-/// Runs each filter over the bag and returns one row per filter.
+/// Runs each filter over the bag and returns one row and the session report per filter.
 fn compare_bag(
     bag: &Path,
     filters: &[String],
     params_dir: Option<&Path>,
-) -> Result<Vec<ComparisonRow>, String> {
+) -> Result<Vec<(ComparisonRow, SessionReport)>, String> {
     let names: Vec<String> = if filters.is_empty() {
         FilterVariant::ALL
             .iter()
@@ -279,11 +319,8 @@ fn compare_bag(
         }
         let runtime = start.elapsed().as_secs_f64();
         let report = session.finish();
-        rows.push(ComparisonRow::new(
-            &name,
-            &report.summary(f64::NEG_INFINITY),
-            runtime,
-        ));
+        let row = ComparisonRow::new(&name, &report.summary(f64::NEG_INFINITY), runtime);
+        rows.push((row, report));
     }
     Ok(rows)
 }

@@ -4,6 +4,7 @@
 pub mod bag_inputs;
 pub mod cli;
 pub mod compare;
+pub mod plots;
 pub mod replay;
 pub mod scenario_inputs;
 pub mod session;

@@ -11,7 +11,7 @@ use crate::engine::Output;
 use crate::eval::{ErrorSummary, TruthSample, TruthTrack};
 use crate::ros::bag::{BagError, BagReader, BagWriter};
 use crate::ros::convert::seconds_to_time;
-use crate::ros::msg::{NavSatFix, NoiseEstimates, Odometry};
+use crate::ros::msg::{Imu, NavSatFix, NoiseEstimates, Odometry, RosMessage};
 use crate::ros::outbound;
 
 use super::bag_inputs::{BagInputs, BagTopics, ReadProblems};
@@ -38,8 +38,16 @@ pub enum ReplayError {
         line: usize,
         reason: String,
     },
-    #[error("{0}: no IMU message on the IMU topic: nothing to replay")]
-    NoImu(String),
+    #[error(
+        "{path}: no {expected} messages on {imu_topic}: nothing to replay (the bag has: {found})"
+    )]
+    NoImu {
+        path: String,
+        imu_topic: String,
+        expected: &'static str,
+        /// The bag's topics as "topic (type, count)".
+        found: String,
+    },
 }
 
 /// Where the reference comes from.
@@ -98,9 +106,23 @@ pub fn replay(
     let has_imu = reader
         .topics()
         .iter()
-        .any(|t| t.topic == topics.imu && t.message_count > 0);
+        .any(|t| t.topic == topics.imu && t.type_name == Imu::TYPE_NAME && t.message_count > 0);
     if !has_imu {
-        return Err(ReplayError::NoImu(bag.display().to_string()));
+        let found: Vec<String> = reader
+            .topics()
+            .iter()
+            .map(|t| format!("{} ({}, {})", t.topic, t.type_name, t.message_count))
+            .collect();
+        return Err(ReplayError::NoImu {
+            path: bag.display().to_string(),
+            imu_topic: topics.imu.clone(),
+            expected: Imu::TYPE_NAME,
+            found: if found.is_empty() {
+                "no readable message".to_owned()
+            } else {
+                found.join(", ")
+            },
+        });
     }
     let mut inputs = BagInputs::new(reader.messages()?, topics);
     let mut session = Session::new(config.clone(), options.score_interval_s, track);
@@ -207,13 +229,16 @@ fn write_output(w: &mut BagWriter, o: &Output, datum: &mut Option<Llh>) -> Resul
 
 const CSV_HEADER: &str = "t_s,lat_deg,lon_deg,height_m,v_e_mps,v_n_mps,v_u_mps,roll_deg,pitch_deg,yaw_deg,sigma_e_m,sigma_n_m,sigma_u_m,clock_bias_m,clock_drift_mps";
 
+/// One solution as a CSV row. Choice: numbers in Rust's shortest round-trip form (every
+/// digit the f64 holds, and no more), so a CSV can serve as a golden reference of the
+/// engine's output and nothing is lost to rounding.
 fn write_csv_row(w: &mut impl Write, sol: &crate::engine::Solution) -> std::io::Result<()> {
     let nav = &sol.nav;
     let (roll, pitch, yaw) = nav.q_nb.euler_angles();
     let p = sol.position_covariance_enu_m2();
     writeln!(
         w,
-        "{:.9},{:.10},{:.10},{:.4},{:.5},{:.5},{:.5},{:.5},{:.5},{:.5},{:.4},{:.4},{:.4},{:.4},{:.5}",
+        "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
         nav.t_s,
         nav.p.lat_rad.to_degrees(),
         nav.p.lon_rad.to_degrees(),
