@@ -9,8 +9,11 @@
 //! - [`outbound`]: engine outputs -> Odometry, NavSatFix, NoiseEstimates.
 //! - [`bag`]: rosbag2-compatible MCAP bag writing and streaming reading.
 
+pub mod args;
 pub mod bag;
 pub mod cdr;
 pub mod convert;
 pub mod msg;
+pub mod names;
+pub mod node;
 pub mod outbound;

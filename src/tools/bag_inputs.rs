@@ -191,7 +191,7 @@ impl Iterator for BagInputs {
 }
 
 /// A receiver fix from NavSatFix (a fix without a solution is skipped).
-fn fix_of(msg: &NavSatFix) -> Option<GnssFix> {
+pub(crate) fn fix_of(msg: &NavSatFix) -> Option<GnssFix> {
     if msg.status.status < 0 {
         return None;
     }
