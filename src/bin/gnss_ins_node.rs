@@ -11,9 +11,9 @@ fn main() -> ExitCode {
         Err(e) => return fail(&e),
     };
     // Choice: without RUST_LOG, RustDDS logs only errors (its warnings about unreachable
-    // locators flood a host without multicast) and everything else at --log-level.
+    // locators flood a host without multicast), ros2-client warnings, the rest at --log-level.
     let level = cli.log_level.as_deref().unwrap_or("info");
-    let filter = format!("{level},rustdds=error");
+    let filter = format!("{level},rustdds=error,ros2_client=warn");
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or(filter)).init();
     let config = match node::params::load_config(&cli) {
         Ok(c) => c,

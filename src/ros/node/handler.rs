@@ -36,6 +36,24 @@ pub enum OutMsg {
     Noise(NoiseEstimates),
 }
 
+/// The node's input streams.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Input {
+    Imu,
+    Gnss,
+    Fix,
+}
+
+impl Input {
+    fn name(self) -> &'static str {
+        match self {
+            Input::Imu => "imu",
+            Input::Gnss => "gnss/measurements",
+            Input::Fix => "gnss/fix",
+        }
+    }
+}
+
 /// Counts of what arrived and what was dropped before the engine.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct InputCounts {
@@ -100,7 +118,7 @@ impl NodeCore {
         self.counts.imu_received += 1;
         let sample = match ImuSample::try_from(msg) {
             Ok(s) => s,
-            Err(e) => return self.unconvertible("imu", &e.to_string()),
+            Err(e) => return self.unconvertible(Input::Imu, &e.to_string()),
         };
         let mut outputs = Vec::new();
         if let Some(last_t_s) = self.engine.last_imu_t_s() {
@@ -130,7 +148,7 @@ impl NodeCore {
         self.counts.gnss_received += 1;
         let epoch = match crate::gnss::GnssEpoch::try_from(msg) {
             Ok(e) => e,
-            Err(e) => return self.unconvertible("gnss", &e.to_string()),
+            Err(e) => return self.unconvertible(Input::Gnss, &e.to_string()),
         };
         let outputs = match self.engine.push_gnss(epoch) {
             Ok(o) => o,
@@ -146,7 +164,7 @@ impl NodeCore {
     pub fn on_fix(&mut self, msg: &NavSatFix) -> Vec<OutMsg> {
         self.counts.fix_received += 1;
         let Some(fix) = fix_of(msg) else {
-            return self.unconvertible("fix", "no solution or invalid stamp");
+            return self.unconvertible(Input::Fix, "no solution or invalid stamp");
         };
         let outputs = match self.engine.push_fix(fix) {
             Ok(o) => o,
@@ -158,14 +176,18 @@ impl NodeCore {
         self.publishable(outputs)
     }
 
-    fn unconvertible(&mut self, what: &'static str, error: &str) -> Vec<OutMsg> {
-        match what {
-            "imu" => self.counts.unconvertible_imu += 1,
-            "gnss" => self.counts.unconvertible_gnss += 1,
-            _ => self.counts.unconvertible_fix += 1,
-        }
-        self.log
-            .warn(what, &format!("dropped {what} message: {error}"));
+    fn unconvertible(&mut self, input: Input, error: &str) -> Vec<OutMsg> {
+        let counter = match input {
+            Input::Imu => &mut self.counts.unconvertible_imu,
+            Input::Gnss => &mut self.counts.unconvertible_gnss,
+            Input::Fix => &mut self.counts.unconvertible_fix,
+        };
+        *counter += 1;
+        let name = input.name();
+        self.log.warn(
+            &format!("unconvertible {name}"),
+            &format!("dropped a message on {name}: {error}"),
+        );
         Vec::new()
     }
 

@@ -25,6 +25,7 @@ use crate::ros::msg::{
 use crate::ros::names::resolve_remapped;
 
 pub use handler::{NodeCore, OutMsg};
+use log_limit::LogLimiter;
 
 /// Queue depth of the subscriptions and publishers.
 ///
@@ -144,10 +145,11 @@ struct Outputs {
     odometry: Publisher<Odometry>,
     fix: Publisher<NavSatFix>,
     noise: Publisher<NoiseEstimates>,
+    log: LogLimiter,
 }
 
 impl Outputs {
-    fn publish(&self, msgs: Vec<OutMsg>) {
+    fn publish(&mut self, msgs: Vec<OutMsg>) {
         for m in msgs {
             let result = match m {
                 OutMsg::Odometry(o) => self.odometry.publish(*o).map_err(|e| format!("{e:?}")),
@@ -155,7 +157,7 @@ impl Outputs {
                 OutMsg::Noise(n) => self.noise.publish(n).map_err(|e| format!("{e:?}")),
             };
             if let Err(e) = result {
-                log::warn!("publish failed: {e}");
+                self.log.warn("publish", &format!("publish failed: {e}"));
             }
         }
     }
@@ -178,10 +180,11 @@ pub fn run(args: &NodeArgs, config: Config, domain_id: u16) -> Result<(), NodeEr
     let imu_sub = subscription::<Imu>(&mut node, &names, "imu")?;
     let gnss_sub = subscription::<GnssMeasurements>(&mut node, &names, "gnss/measurements")?;
     let fix_sub = subscription::<NavSatFix>(&mut node, &names, "gnss/fix")?;
-    let outputs = Outputs {
+    let mut outputs = Outputs {
         odometry: publisher(&mut node, &names, "odometry")?,
         fix: publisher(&mut node, &names, "fix")?,
         noise: publisher(&mut node, &names, "~/noise_estimates")?,
+        log: LogLimiter::default(),
     };
     let diagnostics = publisher::<DiagnosticArray>(&mut node, &names, "/diagnostics")?;
     log::info!(
