@@ -100,7 +100,7 @@ fn node_estimates_a_static_receiver() {
         )
         .unwrap();
     let reliable = QosProfile::publisher_default()
-        .history(ros2_client::qos::History::KeepLast { depth: 1000 });
+        .history(ros2_client::qos::History::KeepLast { depth: 20_000 });
     let topic = |peer: &mut ros2_client::Node, name: &str, t: MessageTypeName| {
         peer.create_topic(&Name::parse(name).unwrap(), t, &reliable)
             .unwrap()
@@ -153,29 +153,31 @@ fn node_estimates_a_static_receiver() {
     );
     imu_pub.publish(bad).unwrap();
 
-    let week = 0;
-    let start = Instant::now();
-    for event in scenario.events() {
-        let event = event.unwrap();
-        let t_s = event.t_s();
-        if t_s > STREAM_S {
-            break;
+    let stream = |until_s: f64| {
+        let start = Instant::now();
+        for event in scenario.events() {
+            let event = event.unwrap();
+            let t_s = event.t_s();
+            if t_s > until_s {
+                break;
+            }
+            let due = Duration::from_secs_f64(t_s / SPEED_UP);
+            if let Some(wait) = due.checked_sub(start.elapsed()) {
+                std::thread::sleep(wait);
+            }
+            let stamp = seconds_to_time(t_s).unwrap();
+            match event {
+                SimEvent::Imu(s) => imu_pub
+                    .publish(outbound::imu(&s, stamp, "imu_link"))
+                    .unwrap(),
+                SimEvent::Gnss { epoch, .. } => gnss_pub
+                    .publish(outbound::gnss_measurements(&epoch, 0, stamp, "gnss"))
+                    .unwrap(),
+                _ => {}
+            }
         }
-        let due = Duration::from_secs_f64(t_s / SPEED_UP);
-        if let Some(wait) = due.checked_sub(start.elapsed()) {
-            std::thread::sleep(wait);
-        }
-        let stamp = seconds_to_time(t_s).unwrap();
-        match event {
-            SimEvent::Imu(s) => imu_pub
-                .publish(outbound::imu(&s, stamp, "imu_link"))
-                .unwrap(),
-            SimEvent::Gnss { epoch, .. } => gnss_pub
-                .publish(outbound::gnss_measurements(&epoch, week, stamp, "gnss"))
-                .unwrap(),
-            _ => {}
-        }
-    }
+    };
+    stream(STREAM_S);
 
     // Collect what the node published.
     let deadline = Instant::now() + Duration::from_secs(3);
@@ -190,8 +192,9 @@ fn node_estimates_a_static_receiver() {
         }
         std::thread::sleep(Duration::from_millis(20));
     }
+    // One Odometry per IMU sample from the initialization at 1 s: about 5900.
     assert!(
-        odometry.len() > 100,
+        odometry.len() > 5000,
         "only {} Odometry messages received",
         odometry.len()
     );
@@ -236,6 +239,30 @@ fn node_estimates_a_static_receiver() {
     eprintln!("diagnostics: {:?}", diagnostics.status[0].values);
     assert_eq!(value("phase").as_deref(), Some("running"));
     assert_eq!(value("unconvertible_imu").as_deref(), Some("1"));
+    assert_eq!(value("time_jump_resets").as_deref(), Some("0"));
+
+    // The bag plays again from its start: the node resets once and carries on.
+    stream(5.0);
+    let deadline = Instant::now() + Duration::from_secs(3);
+    let mut resets = None;
+    let mut after = 0;
+    while Instant::now() < deadline {
+        while let Ok(Some((o, _))) = odom_sub.take() {
+            assert!(o.pose.pose.position.x.is_finite(), "{o:?}");
+            after += 1;
+        }
+        while let Ok(Some((d, _))) = diag_sub.take() {
+            resets = d.status[0]
+                .values
+                .iter()
+                .find(|kv| kv.key == "time_jump_resets")
+                .map(|kv| kv.value.clone());
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    eprintln!("{after} Odometry messages after the time jump");
+    assert_eq!(resets.as_deref(), Some("1"));
+    assert!(after > 0, "no Odometry after the reset");
 }
 
 #[test]
