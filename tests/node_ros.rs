@@ -142,7 +142,7 @@ fn node_estimates_a_static_receiver() {
     assert!(matched, "the node's topics were not discovered within 20 s");
 
     // One bad IMU sample first: counted and dropped, the node stays up.
-    let bad = outbound::imu(
+    let bad: Imu = outbound::imu(
         &adaptive_gnss_ins::ins::ImuSample {
             t_s: 0.0,
             w_ib_b_rad_s: nalgebra::Vector3::new(f64::NAN, 0.0, 0.0),
@@ -151,10 +151,33 @@ fn node_estimates_a_static_receiver() {
         seconds_to_time(0.0).unwrap(),
         "imu_link",
     );
-    imu_pub.publish(bad).unwrap();
+    // Our side having matched does not mean the node's reader has matched our writer yet
+    // (best effort drops what it sends before): repeat the bad sample until the node's
+    // diagnostics count it, which also proves the whole path is up before streaming.
+    let key_value = |d: &DiagnosticArray, key: &str| {
+        d.status[0]
+            .values
+            .iter()
+            .find(|kv| kv.key == key)
+            .and_then(|kv| kv.value.parse::<u64>().ok())
+    };
+    let deadline = Instant::now() + Duration::from_secs(20);
+    let mut bad_counted = 0;
+    while bad_counted == 0 {
+        assert!(
+            Instant::now() < deadline,
+            "the node never reported the bad IMU sample"
+        );
+        imu_pub.publish(bad.clone()).unwrap();
+        std::thread::sleep(Duration::from_millis(250));
+        while let Ok(Some((d, _))) = diag_sub.take() {
+            bad_counted = key_value(&d, "unconvertible_imu").unwrap_or(0);
+        }
+    }
 
     let stream = |until_s: f64| {
         let start = Instant::now();
+        let mut imu_sent = 0u64;
         for event in scenario.events() {
             let event = event.unwrap();
             let t_s = event.t_s();
@@ -167,17 +190,21 @@ fn node_estimates_a_static_receiver() {
             }
             let stamp = seconds_to_time(t_s).unwrap();
             match event {
-                SimEvent::Imu(s) => imu_pub
-                    .publish(outbound::imu(&s, stamp, "imu_link"))
-                    .unwrap(),
+                SimEvent::Imu(s) => {
+                    imu_sent += 1;
+                    imu_pub
+                        .publish(outbound::imu(&s, stamp, "imu_link"))
+                        .unwrap()
+                }
                 SimEvent::Gnss { epoch, .. } => gnss_pub
                     .publish(outbound::gnss_measurements(&epoch, 0, stamp, "gnss"))
                     .unwrap(),
                 _ => {}
             }
         }
+        imu_sent
     };
-    stream(STREAM_S);
+    let imu_sent = stream(STREAM_S);
 
     // Collect what the node published.
     let deadline = Instant::now() + Duration::from_secs(3);
@@ -238,7 +265,14 @@ fn node_estimates_a_static_receiver() {
     };
     eprintln!("diagnostics: {:?}", diagnostics.status[0].values);
     assert_eq!(value("phase").as_deref(), Some("running"));
-    assert_eq!(value("unconvertible_imu").as_deref(), Some("1"));
+    let unconvertible: u64 = value("unconvertible_imu").unwrap().parse().unwrap();
+    let received: u64 = value("imu_received").unwrap().parse().unwrap();
+    assert!(unconvertible >= bad_counted, "the bad samples are counted");
+    assert_eq!(
+        received - unconvertible,
+        imu_sent,
+        "every good IMU sample arrived"
+    );
     assert_eq!(value("time_jump_resets").as_deref(), Some("0"));
 
     // The bag plays again from its start: the node resets once and carries on.
