@@ -404,4 +404,46 @@ mod tests {
         feed(&mut core, 10.7, 11.0);
         assert_eq!(core.engine().last_imu_t_s(), Some(10.99));
     }
+
+    #[test]
+    fn loose_coupling_runs_on_fixes_and_counts_raw_epochs_as_wrong_coupling() {
+        use crate::sim::{Scenario, SimEvent};
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/params/ekf_loose.yaml");
+        let text = std::fs::read_to_string(path).unwrap();
+        let mut config = Config::from_yaml_str(&text, path).unwrap();
+        // The static scenario faces north (ENU yaw 90 deg); heading is not observable at rest.
+        config.set_parameter("init.heading_deg", "0.0").unwrap();
+        let mut core = NodeCore::new(config);
+        let scenario = Scenario::builtin("static", 5).unwrap();
+        let (mut odometry, mut epochs) = (0, 0);
+        for event in scenario.events() {
+            let event = event.unwrap();
+            if event.t_s() > 30.0 {
+                break;
+            }
+            let stamp = seconds_to_time(event.t_s()).unwrap();
+            let out = match event {
+                SimEvent::Imu(s) => core.on_imu(&outbound::imu(&s, stamp, "imu")),
+                SimEvent::Fix(f) => core.on_fix(&outbound::receiver_fix(&f, stamp, "gnss")),
+                SimEvent::Gnss { epoch, .. } => {
+                    epochs += 1;
+                    core.on_gnss(&outbound::gnss_measurements(&epoch, 0, stamp, "gnss"))
+                }
+                _ => Vec::new(),
+            };
+            odometry += out
+                .iter()
+                .filter(|m| matches!(m, OutMsg::Odometry(_)))
+                .count();
+        }
+        assert!(odometry > 2000, "{odometry} odometry messages in 30 s");
+        assert_eq!(core.engine().init_phase(), None, "running");
+        assert_eq!(core.counts().unconvertible_fix, 0);
+        assert_eq!(
+            core.engine()
+                .counters()
+                .count(RejectionReason::WrongCoupling),
+            epochs
+        );
+    }
 }
