@@ -151,9 +151,11 @@ fn node_estimates_a_static_receiver() {
         seconds_to_time(0.0).unwrap(),
         "imu_link",
     );
-    // Our side having matched does not mean the node's reader has matched our writer yet
-    // (best effort drops what it sends before): repeat the bad sample until the node's
-    // diagnostics count it, which also proves the whole path is up before streaming.
+    // An empty GNSS epoch, rejected by the engine for having no satellites.
+    let empty = GnssMeasurements::default();
+    // Our side having matched does not mean the node's readers have matched our writers
+    // yet (best effort drops what it sends before): repeat the bad messages until the
+    // node's diagnostics count both, which proves both input paths are up before streaming.
     let key_value = |d: &DiagnosticArray, key: &str| {
         d.status[0]
             .values
@@ -162,22 +164,23 @@ fn node_estimates_a_static_receiver() {
             .and_then(|kv| kv.value.parse::<u64>().ok())
     };
     let deadline = Instant::now() + Duration::from_secs(20);
-    let mut bad_counted = 0;
-    while bad_counted == 0 {
+    let (mut bad_counted, mut empty_counted) = (0, 0);
+    while bad_counted == 0 || empty_counted == 0 {
         assert!(
             Instant::now() < deadline,
-            "the node never reported the bad IMU sample"
+            "the node never reported the bad IMU sample and the empty GNSS epoch"
         );
         imu_pub.publish(bad.clone()).unwrap();
+        gnss_pub.publish(empty.clone()).unwrap();
         std::thread::sleep(Duration::from_millis(250));
         while let Ok(Some((d, _))) = diag_sub.take() {
             bad_counted = key_value(&d, "unconvertible_imu").unwrap_or(0);
+            empty_counted = key_value(&d, "rejected_gnss_no_satellites").unwrap_or(0);
         }
     }
-
     let stream = |until_s: f64| {
         let start = Instant::now();
-        let mut imu_sent = 0u64;
+        let (mut imu_sent, mut gnss_sent) = (0u64, 0u64);
         for event in scenario.events() {
             let event = event.unwrap();
             let t_s = event.t_s();
@@ -196,15 +199,18 @@ fn node_estimates_a_static_receiver() {
                         .publish(outbound::imu(&s, stamp, "imu_link"))
                         .unwrap()
                 }
-                SimEvent::Gnss { epoch, .. } => gnss_pub
-                    .publish(outbound::gnss_measurements(&epoch, 0, stamp, "gnss"))
-                    .unwrap(),
+                SimEvent::Gnss { epoch, .. } => {
+                    gnss_sent += 1;
+                    gnss_pub
+                        .publish(outbound::gnss_measurements(&epoch, 0, stamp, "gnss"))
+                        .unwrap()
+                }
                 _ => {}
             }
         }
-        imu_sent
+        (imu_sent, gnss_sent)
     };
-    let imu_sent = stream(STREAM_S);
+    let (imu_sent, gnss_sent) = stream(STREAM_S);
 
     // Collect what the node published.
     let deadline = Instant::now() + Duration::from_secs(3);
@@ -272,6 +278,16 @@ fn node_estimates_a_static_receiver() {
         received - unconvertible,
         imu_sent,
         "every good IMU sample arrived"
+    );
+    let empty_rejected: u64 = value("rejected_gnss_no_satellites")
+        .unwrap()
+        .parse()
+        .unwrap();
+    let gnss_received: u64 = value("gnss_received").unwrap().parse().unwrap();
+    assert_eq!(
+        gnss_received - empty_rejected,
+        gnss_sent,
+        "every GNSS epoch arrived"
     );
     assert_eq!(value("time_jump_resets").as_deref(), Some("0"));
 
