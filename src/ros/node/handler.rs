@@ -57,8 +57,11 @@ impl Input {
 /// Counts of what arrived and what was dropped before the engine.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct InputCounts {
+    /// Imu messages decoded.
     pub imu_received: u64,
+    /// GnssMeasurements messages decoded.
     pub gnss_received: u64,
+    /// NavSatFix messages decoded.
     pub fix_received: u64,
     /// Payloads that did not decode, any topic.
     pub undecodable: u64,

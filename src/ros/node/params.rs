@@ -28,6 +28,13 @@ pub enum ParamsError {
     },
 }
 
+/// The standard ROS parameter every launch file may set.
+///
+/// Choice: it is accepted and has no effect. The filter runs on the stamps of its inputs
+/// (so a bag replayed with `--clock` is processed on the bag's time either way) and its
+/// outputs carry those stamps; only the /diagnostics header uses the wall clock.
+pub const USE_SIM_TIME: &str = "use_sim_time";
+
 /// The configuration of `args` where `params_text` is the content of `args.params_file`
 /// (None: no file; the defaults of `params/ekf.yaml` apply).
 pub fn config_from(args: &NodeArgs, params_text: Option<&str>) -> Result<Config, ParamsError> {
@@ -38,11 +45,12 @@ pub fn config_from(args: &NodeArgs, params_text: Option<&str>) -> Result<Config,
     let mut config = match params_text {
         Some(text) => {
             check_node_key(text, &origin, args)?;
-            Config::from_yaml_str(text, &origin).map_err(|e| ParamsError::Config(Box::new(e)))?
+            let text = without_use_sim_time(text);
+            Config::from_yaml_str(&text, &origin).map_err(|e| ParamsError::Config(Box::new(e)))?
         }
         None => Config::default(),
     };
-    for (name, value) in &args.parameters {
+    for (name, value) in args.parameters.iter().filter(|(n, _)| n != USE_SIM_TIME) {
         config
             .set_parameter(name, value)
             .map_err(|source| ParamsError::Override {
@@ -52,6 +60,27 @@ pub fn config_from(args: &NodeArgs, params_text: Option<&str>) -> Result<Config,
             })?;
     }
     Ok(config)
+}
+
+/// `text` without a `use_sim_time` entry under its node's `ros__parameters` (unchanged,
+/// keeping the line numbers of the loader's errors, when there is none).
+fn without_use_sim_time(text: &str) -> std::borrow::Cow<'_, str> {
+    use serde_yaml::Value;
+    let Ok(mut document) = serde_yaml::from_str::<Value>(text) else {
+        return text.into();
+    };
+    let mut removed = false;
+    if let Value::Mapping(nodes) = &mut document {
+        for (_, node) in nodes.iter_mut() {
+            if let Some(Value::Mapping(parameters)) = node.get_mut("ros__parameters") {
+                removed |= parameters.remove(USE_SIM_TIME).is_some();
+            }
+        }
+    }
+    match (removed, serde_yaml::to_string(&document)) {
+        (true, Ok(stripped)) => stripped.into(),
+        _ => text.into(),
+    }
 }
 
 /// Rejects a file whose single top-level key names another node. Files of any other shape
@@ -136,6 +165,24 @@ mod tests {
         let e = config_from(&args(&["-p", "filter.no_such_key:=1"]), Some(FILE)).unwrap_err();
         assert!(matches!(e, ParamsError::Override { .. }), "{e}");
         assert!(e.to_string().contains("filter.no_such_key"), "{e}");
+    }
+
+    #[test]
+    fn use_sim_time_is_accepted_and_ignored() {
+        let file = FILE.replace(
+            "ros__parameters:\n",
+            "ros__parameters:\n    use_sim_time: true\n",
+        );
+        assert!(
+            Config::from_yaml_str(&file, "p.yaml").is_err(),
+            "the core's loader alone refuses the key"
+        );
+        let c = config_from(&args(&["-p", "use_sim_time:=true"]), Some(&file)).unwrap();
+        assert_eq!(c.filter.variant.as_str(), "ermakf");
+        // Files without it keep the loader's line numbers in errors.
+        let bad = FILE.replace("ermakf", "no_such_variant");
+        let e = config_from(&args(&[]), Some(&bad)).unwrap_err().to_string();
+        assert!(e.contains("p.yaml"), "{e}");
     }
 
     #[test]
