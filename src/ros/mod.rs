@@ -8,9 +8,14 @@
 //! - [`convert`]: wire messages -> core types (`GnssEpoch`, `ImuSample`) and ROS time.
 //! - [`outbound`]: engine outputs -> Odometry, NavSatFix, NoiseEstimates.
 //! - [`bag`]: rosbag2-compatible MCAP bag writing and streaming reading.
+//! - [`args`]: the node's `--ros-args` command line; [`names`]: topic-name resolution.
+//! - [`node`]: the `gnss_ins_node` ROS 2 node (ros2-client) around the engine.
 
+pub mod args;
 pub mod bag;
 pub mod cdr;
 pub mod convert;
 pub mod msg;
+pub mod names;
+pub mod node;
 pub mod outbound;

@@ -260,7 +260,7 @@ impl Iterator for BagInputs {
 }
 
 /// A receiver fix from a NavSatFix with a solution, stamped `t_s`.
-fn fix_of(msg: &NavSatFix, t_s: f64) -> GnssFix {
+pub(crate) fn fix_of(msg: &NavSatFix, t_s: f64) -> GnssFix {
     let c = &msg.position_covariance;
     let covariance = (msg.position_covariance_type != NavSatFix::COVARIANCE_TYPE_UNKNOWN)
         .then(|| Matrix3::from_fn(|r, k| c[3 * r + k]));

@@ -1,0 +1,454 @@
+//! The node's message handling without any DDS: decoded messages in, messages to publish
+//! out. It converts, feeds the engine, counts and logs; it holds no filter math.
+
+use crate::config::Config;
+use crate::earth::Llh;
+use crate::engine::{Engine, Output, ResetReason, StatusEvent};
+use crate::ins::ImuSample;
+use crate::ros::convert::{seconds_to_time, time_to_seconds};
+use crate::ros::msg::{
+    DiagnosticArray, DiagnosticStatus, GnssMeasurements, Header, Imu, KeyValue, NavSatFix,
+    NoiseEstimates, Odometry, Time,
+};
+use crate::ros::outbound;
+use crate::tools::bag_inputs::fix_of;
+
+use super::log_limit::LogLimiter;
+
+/// Frame of the odometry pose (local ENU at the datum).
+pub const MAP_FRAME: &str = "map";
+/// Frame of the vehicle body (FLU).
+pub const BODY_FRAME: &str = "base_link";
+
+/// Choice: an IMU stamp more than this much older than the last accepted one is a time
+/// jump (a bag played in a loop) and resets the filter; smaller steps back are ordinary
+/// out-of-order samples the engine rejects. 1 s is far beyond any transport reordering.
+pub const TIME_JUMP_BACK_S: f64 = 1.0;
+
+/// A message the node publishes.
+#[derive(Debug, Clone, PartialEq)]
+pub enum OutMsg {
+    /// On `odometry`.
+    Odometry(Box<Odometry>),
+    /// On `fix`.
+    Fix(NavSatFix),
+    /// On `~/noise_estimates`.
+    Noise(NoiseEstimates),
+}
+
+/// The node's input streams.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Input {
+    Imu,
+    Gnss,
+    Fix,
+}
+
+impl Input {
+    fn name(self) -> &'static str {
+        match self {
+            Input::Imu => "imu",
+            Input::Gnss => "gnss/measurements",
+            Input::Fix => "gnss/fix",
+        }
+    }
+}
+
+/// Counts of what arrived and what was dropped before the engine.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct InputCounts {
+    /// Imu messages decoded.
+    pub imu_received: u64,
+    /// GnssMeasurements messages decoded.
+    pub gnss_received: u64,
+    /// NavSatFix messages decoded.
+    pub fix_received: u64,
+    /// Payloads that did not decode, any topic.
+    pub undecodable: u64,
+    /// IMU messages that decoded but did not convert (bad stamp, NaN).
+    pub unconvertible_imu: u64,
+    /// GNSS messages that did not convert (bad stamp or time of week, unknown constellation).
+    pub unconvertible_gnss: u64,
+    /// NavSatFix messages without a solution or with a bad stamp.
+    pub unconvertible_fix: u64,
+    /// Resets because the IMU time jumped backwards.
+    pub time_jump_resets: u64,
+    /// Outputs not published because a value was not finite.
+    pub non_finite_outputs: u64,
+}
+
+/// Engine plus message conversion for one node.
+pub struct NodeCore {
+    engine: Engine,
+    datum: Option<Llh>,
+    counts: InputCounts,
+    log: LogLimiter,
+}
+
+impl NodeCore {
+    /// A node core running `config`.
+    pub fn new(config: Config) -> Self {
+        let datum = config.output.datum;
+        Self {
+            engine: Engine::new(config),
+            datum,
+            counts: InputCounts::default(),
+            log: LogLimiter::default(),
+        }
+    }
+
+    /// The input counters.
+    pub fn counts(&self) -> &InputCounts {
+        &self.counts
+    }
+
+    /// The engine (for its counters and phase).
+    pub fn engine(&self) -> &Engine {
+        &self.engine
+    }
+
+    /// Records a payload on `topic` that did not decode.
+    pub fn on_undecodable(&mut self, topic: &str, error: &str) {
+        self.counts.undecodable += 1;
+        self.log.warn(
+            "undecodable",
+            &format!("undecodable message on {topic}: {error}"),
+        );
+    }
+
+    /// Handles one sensor_msgs/Imu.
+    pub fn on_imu(&mut self, msg: &Imu) -> Vec<OutMsg> {
+        self.counts.imu_received += 1;
+        let sample = match ImuSample::try_from(msg) {
+            Ok(s) => s,
+            Err(e) => return self.unconvertible(Input::Imu, &e.to_string()),
+        };
+        let mut outputs = Vec::new();
+        if let Some(last_t_s) = self.engine.last_imu_t_s() {
+            if sample.t_s < last_t_s - TIME_JUMP_BACK_S {
+                self.counts.time_jump_resets += 1;
+                log::warn!(
+                    "IMU time jumped back from {last_t_s:.3} s to {:.3} s: resetting the filter",
+                    sample.t_s
+                );
+                outputs.push(
+                    self.engine
+                        .reset(sample.t_s, ResetReason::TimeJumpBackwards),
+                );
+            }
+        }
+        match self.engine.push_imu(&sample) {
+            Ok(o) => outputs.extend(o),
+            Err(e) => {
+                self.log.warn(e.reason.name(), &format!("imu: {e}"));
+            }
+        }
+        self.publishable(outputs)
+    }
+
+    /// Handles one GnssMeasurements (tight coupling).
+    pub fn on_gnss(&mut self, msg: &GnssMeasurements) -> Vec<OutMsg> {
+        self.counts.gnss_received += 1;
+        let epoch = match crate::gnss::GnssEpoch::try_from(msg) {
+            Ok(e) => e,
+            Err(e) => return self.unconvertible(Input::Gnss, &e.to_string()),
+        };
+        let outputs = match self.engine.push_gnss(epoch) {
+            Ok(o) => o,
+            Err(e) => {
+                self.log.warn(e.reason.name(), &format!("gnss: {e}"));
+                Vec::new()
+            }
+        };
+        self.publishable(outputs)
+    }
+
+    /// Handles one NavSatFix (loose coupling); a fix without a solution is ignored.
+    pub fn on_fix(&mut self, msg: &NavSatFix) -> Vec<OutMsg> {
+        self.counts.fix_received += 1;
+        let t_s = match time_to_seconds(&msg.header.stamp) {
+            Ok(t) if msg.status.status >= 0 => t,
+            _ => return self.unconvertible(Input::Fix, "no solution or invalid stamp"),
+        };
+        let fix = fix_of(msg, t_s);
+        let outputs = match self.engine.push_fix(fix) {
+            Ok(o) => o,
+            Err(e) => {
+                self.log.warn(e.reason.name(), &format!("fix: {e}"));
+                Vec::new()
+            }
+        };
+        self.publishable(outputs)
+    }
+
+    fn unconvertible(&mut self, input: Input, error: &str) -> Vec<OutMsg> {
+        let counter = match input {
+            Input::Imu => &mut self.counts.unconvertible_imu,
+            Input::Gnss => &mut self.counts.unconvertible_gnss,
+            Input::Fix => &mut self.counts.unconvertible_fix,
+        };
+        *counter += 1;
+        let name = input.name();
+        self.log.warn(
+            &format!("unconvertible {name}"),
+            &format!("dropped a message on {name}: {error}"),
+        );
+        Vec::new()
+    }
+
+    fn publishable(&mut self, outputs: Vec<Output>) -> Vec<OutMsg> {
+        let mut msgs = Vec::new();
+        for output in outputs {
+            match output {
+                Output::Solution(sol) => {
+                    let Ok(stamp) = seconds_to_time(sol.nav.t_s) else {
+                        self.counts.non_finite_outputs += 1;
+                        continue;
+                    };
+                    let datum = *self.datum.get_or_insert(sol.nav.p);
+                    let odom = outbound::odometry(&sol, &datum, stamp, MAP_FRAME, BODY_FRAME);
+                    let fix = outbound::nav_sat_fix(&sol, stamp, BODY_FRAME);
+                    if odometry_is_finite(&odom) && fix_is_finite(&fix) {
+                        msgs.push(OutMsg::Odometry(Box::new(odom)));
+                        msgs.push(OutMsg::Fix(fix));
+                    } else {
+                        self.counts.non_finite_outputs += 1;
+                        self.log.warn(
+                            "non_finite_output",
+                            "solution with a non-finite value dropped",
+                        );
+                    }
+                }
+                Output::Epoch(report) => {
+                    if let Ok(stamp) = seconds_to_time(report.t_s) {
+                        msgs.push(OutMsg::Noise(outbound::noise_estimates(
+                            &report, stamp, BODY_FRAME,
+                        )));
+                    }
+                }
+                Output::Status(StatusEvent::Initialized {
+                    t_s,
+                    heading_from_motion,
+                }) => log::info!(
+                    "filter initialized at {t_s:.3} s (heading from {})",
+                    if heading_from_motion {
+                        "motion"
+                    } else {
+                        "the configuration"
+                    }
+                ),
+                Output::Status(StatusEvent::Reset { t_s, reason }) => {
+                    log::warn!("filter reset at {t_s:.3} s: {reason:?}")
+                }
+            }
+        }
+        msgs
+    }
+
+    /// The /diagnostics report at `stamp`: input counts, rejections by reason, phase.
+    pub fn diagnostics(&self, node_name: &str, stamp: Time) -> DiagnosticArray {
+        let phase = match self.engine.init_phase() {
+            Some(p) => format!("initializing ({p:?})"),
+            None => "running".to_owned(),
+        };
+        let c = &self.counts;
+        let mut values: Vec<KeyValue> = [
+            ("variant", self.engine.variant_name().to_owned()),
+            ("phase", phase.clone()),
+            ("imu_received", c.imu_received.to_string()),
+            ("gnss_received", c.gnss_received.to_string()),
+            ("fix_received", c.fix_received.to_string()),
+            ("undecodable", c.undecodable.to_string()),
+            ("unconvertible_imu", c.unconvertible_imu.to_string()),
+            ("unconvertible_gnss", c.unconvertible_gnss.to_string()),
+            ("unconvertible_fix", c.unconvertible_fix.to_string()),
+            ("time_jump_resets", c.time_jump_resets.to_string()),
+            ("non_finite_outputs", c.non_finite_outputs.to_string()),
+        ]
+        .into_iter()
+        .map(|(key, value)| KeyValue {
+            key: key.to_owned(),
+            value,
+        })
+        .collect();
+        values.extend(self.engine.counters().iter().map(|(reason, n)| KeyValue {
+            key: format!("rejected_{}", reason.name()),
+            value: n.to_string(),
+        }));
+        let running = self.engine.init_phase().is_none();
+        DiagnosticArray {
+            header: Header {
+                stamp,
+                frame_id: String::new(),
+            },
+            status: vec![DiagnosticStatus {
+                level: if running {
+                    DiagnosticStatus::OK
+                } else {
+                    DiagnosticStatus::WARN
+                },
+                name: format!("{node_name}: filter"),
+                message: phase,
+                hardware_id: String::new(),
+                values,
+            }],
+        }
+    }
+}
+
+fn odometry_is_finite(o: &Odometry) -> bool {
+    let p = &o.pose.pose;
+    let t = &o.twist.twist;
+    [
+        p.position.x,
+        p.position.y,
+        p.position.z,
+        p.orientation.x,
+        p.orientation.y,
+        p.orientation.z,
+        p.orientation.w,
+        t.linear.x,
+        t.linear.y,
+        t.linear.z,
+        t.angular.x,
+        t.angular.y,
+        t.angular.z,
+    ]
+    .iter()
+    .chain(o.pose.covariance.iter())
+    .chain(o.twist.covariance.iter())
+    .all(|v| v.is_finite())
+}
+
+fn fix_is_finite(f: &NavSatFix) -> bool {
+    [f.latitude, f.longitude, f.altitude]
+        .iter()
+        .chain(f.position_covariance.iter())
+        .all(|v| v.is_finite())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::engine::RejectionReason;
+
+    fn imu_at(t_s: f64) -> Imu {
+        let sample = ImuSample {
+            t_s,
+            w_ib_b_rad_s: nalgebra::Vector3::zeros(),
+            f_ib_b_m_s2: nalgebra::Vector3::new(0.0, 0.0, 9.8),
+        };
+        outbound::imu(&sample, seconds_to_time(t_s).unwrap(), "imu")
+    }
+
+    fn feed(core: &mut NodeCore, t0_s: f64, t1_s: f64) {
+        let n = ((t1_s - t0_s) * 100.0).round() as usize;
+        for k in 0..n {
+            core.on_imu(&imu_at(t0_s + k as f64 * 0.01));
+        }
+    }
+
+    fn diagnostic(core: &NodeCore, key: &str) -> Option<String> {
+        let d = core.diagnostics("/n", Time::default());
+        d.status[0]
+            .values
+            .iter()
+            .find(|kv| kv.key == key)
+            .map(|kv| kv.value.clone())
+    }
+
+    #[test]
+    fn time_jump_backwards_resets_small_steps_are_rejected() {
+        let mut core = NodeCore::new(Config::default());
+        feed(&mut core, 100.0, 102.0);
+        core.on_imu(&imu_at(101.5));
+        assert_eq!(core.counts().time_jump_resets, 0);
+        assert_eq!(
+            core.engine()
+                .counters()
+                .count(RejectionReason::ImuOutOfOrder),
+            1
+        );
+        feed(&mut core, 50.0, 51.0);
+        assert_eq!(core.counts().time_jump_resets, 1);
+        assert_eq!(core.engine().last_imu_t_s(), Some(50.99));
+        assert_eq!(
+            core.engine()
+                .counters()
+                .count(RejectionReason::ImuOutOfOrder),
+            1,
+            "the samples after the jump are accepted"
+        );
+        assert_eq!(diagnostic(&core, "time_jump_resets").as_deref(), Some("1"));
+        assert_eq!(diagnostic(&core, "imu_received").as_deref(), Some("301"));
+    }
+
+    #[test]
+    fn bad_inputs_are_counted_and_dropped() {
+        let mut core = NodeCore::new(Config::default());
+        feed(&mut core, 10.0, 10.5);
+        let mut nan = imu_at(10.5);
+        nan.linear_acceleration.y = f64::NAN;
+        assert!(core.on_imu(&nan).is_empty());
+        let mut bad_stamp = imu_at(10.6);
+        bad_stamp.header.stamp.nanosec = 1_500_000_000;
+        assert!(core.on_imu(&bad_stamp).is_empty());
+        core.on_undecodable("imu", "truncated payload");
+        let mut no_fix = NavSatFix::default();
+        no_fix.status.status = -1;
+        assert!(core.on_fix(&no_fix).is_empty());
+        assert_eq!(core.counts().unconvertible_imu, 2, "NaN and a bad stamp");
+        assert_eq!(core.counts().unconvertible_fix, 1);
+        assert_eq!(core.counts().undecodable, 1);
+        assert_eq!(diagnostic(&core, "unconvertible_imu").as_deref(), Some("2"));
+        assert_eq!(
+            diagnostic(&core, "phase").as_deref(),
+            Some("initializing (Leveling)")
+        );
+        // The node goes on with good data.
+        feed(&mut core, 10.7, 11.0);
+        assert_eq!(core.engine().last_imu_t_s(), Some(10.99));
+    }
+
+    #[test]
+    fn loose_coupling_runs_on_fixes_and_counts_raw_epochs_as_wrong_coupling() {
+        use crate::sim::{Scenario, SimEvent};
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/params/ekf_loose.yaml");
+        let text = std::fs::read_to_string(path).unwrap();
+        let mut config = Config::from_yaml_str(&text, path).unwrap();
+        // The static scenario faces north (ENU yaw 90 deg); heading is not observable at rest.
+        config.set_parameter("init.heading_deg", "0.0").unwrap();
+        let mut core = NodeCore::new(config);
+        let scenario = Scenario::builtin("static", 5).unwrap();
+        let (mut odometry, mut epochs) = (0, 0);
+        for event in scenario.events() {
+            let event = event.unwrap();
+            if event.t_s() > 30.0 {
+                break;
+            }
+            let stamp = seconds_to_time(event.t_s()).unwrap();
+            let out = match event {
+                SimEvent::Imu(s) => core.on_imu(&outbound::imu(&s, stamp, "imu")),
+                SimEvent::Fix(f) => core.on_fix(&outbound::receiver_fix(&f, stamp, "gnss")),
+                SimEvent::Gnss { epoch, .. } => {
+                    epochs += 1;
+                    core.on_gnss(&outbound::gnss_measurements(&epoch, 0, stamp, "gnss"))
+                }
+                _ => Vec::new(),
+            };
+            odometry += out
+                .iter()
+                .filter(|m| matches!(m, OutMsg::Odometry(_)))
+                .count();
+        }
+        assert!(odometry > 2000, "{odometry} odometry messages in 30 s");
+        assert_eq!(core.engine().init_phase(), None, "running");
+        assert_eq!(core.counts().unconvertible_fix, 0);
+        assert_eq!(
+            core.engine()
+                .counters()
+                .count(RejectionReason::WrongCoupling),
+            epochs
+        );
+    }
+}

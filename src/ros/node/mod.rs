@@ -1,0 +1,262 @@
+//! The `gnss_ins_node` ROS 2 node: DDS subscriptions and publishers around [`NodeCore`].
+//!
+//! Topics (relative, so `__ns` and remappings apply): subscribes `imu`
+//! (sensor_msgs/Imu), `gnss/measurements` (GnssMeasurements), `gnss/fix` (NavSatFix);
+//! publishes `odometry` (nav_msgs/Odometry, `map` → `base_link`), `fix` (NavSatFix),
+//! `~/noise_estimates` (NoiseEstimates) and `/diagnostics` (DiagnosticArray, 1 Hz).
+
+pub mod handler;
+pub mod log_limit;
+pub mod params;
+
+use std::time::{Duration, SystemTime, UNIX_EPOCH};
+
+use futures::stream::{self, StreamExt};
+use ros2_client::{
+    qos::History, Context, ContextOptions, MessageInfo, MessageTypeName, Name, Node, NodeName,
+    NodeOptions, Publisher, QosProfile, ReadResult, Subscription,
+};
+
+use crate::config::Config;
+use crate::ros::args::NodeArgs;
+use crate::ros::msg::{
+    DiagnosticArray, GnssMeasurements, Imu, NavSatFix, NoiseEstimates, Odometry, RosMessage, Time,
+};
+use crate::ros::names::resolve_remapped;
+
+pub use handler::{NodeCore, OutMsg};
+use log_limit::LogLimiter;
+
+/// Queue depth of the subscriptions and publishers.
+///
+/// Choice: 200 holds one second of a 200 Hz IMU, so a short stall of the node loses
+/// nothing; GNSS (1–10 Hz) needs far less but a common depth keeps things simple.
+pub const QUEUE_DEPTH: usize = 200;
+
+/// Period of the /diagnostics report.
+pub const DIAGNOSTICS_PERIOD: Duration = Duration::from_secs(1);
+
+/// Why the node could not start or stopped.
+#[derive(Debug, thiserror::Error)]
+pub enum NodeError {
+    #[error("ROS_DOMAIN_ID `{0}` is not a number in 0..=232")]
+    BadDomainId(String),
+    #[error("cannot create the DDS participant or node: {0}")]
+    Dds(String),
+    #[error("invalid topic name `{0}`")]
+    TopicName(String),
+}
+
+/// The DDS domain of `ROS_DOMAIN_ID` (unset or empty: 0).
+pub fn domain_id_from(value: Option<&str>) -> Result<u16, NodeError> {
+    match value.map(str::trim) {
+        None | Some("") => Ok(0),
+        Some(v) => v
+            .parse::<u16>()
+            .ok()
+            .filter(|d| *d <= 232)
+            .ok_or_else(|| NodeError::BadDomainId(v.to_owned())),
+    }
+}
+
+fn dds_error(e: impl std::fmt::Debug) -> NodeError {
+    NodeError::Dds(format!("{e:?}"))
+}
+
+/// The `MessageTypeName` of a ROS message type (`pkg/msg/Name`).
+fn type_name<M: RosMessage>() -> MessageTypeName {
+    let package = M::TYPE_NAME.split('/').next().unwrap_or_default();
+    let name = M::TYPE_NAME.rsplit('/').next().unwrap_or_default();
+    MessageTypeName::new(package, name)
+}
+
+/// Best-effort subscription QoS: matches both best-effort and reliable publishers.
+fn sensor_qos() -> QosProfile {
+    QosProfile::subscription_default()
+        .reliability_best_effort()
+        .history(History::KeepLast { depth: QUEUE_DEPTH })
+}
+
+/// Reliable publisher QoS (matches reliable and best-effort subscribers).
+fn output_qos() -> QosProfile {
+    QosProfile::publisher_default().history(History::KeepLast { depth: QUEUE_DEPTH })
+}
+
+struct Names<'a> {
+    args: &'a NodeArgs,
+}
+
+impl Names<'_> {
+    fn topic(&self, relative: &str) -> Result<Name, NodeError> {
+        let a = self.args;
+        let full = resolve_remapped(relative, &a.namespace, &a.node_name, &a.remaps);
+        Name::parse(&full).map_err(|_| NodeError::TopicName(full.clone()))
+    }
+}
+
+fn subscription<M: RosMessage + 'static>(
+    node: &mut Node,
+    names: &Names,
+    relative: &str,
+) -> Result<Subscription<M>, NodeError> {
+    let name = names.topic(relative)?;
+    let topic = node
+        .create_topic(&name, type_name::<M>(), &sensor_qos())
+        .map_err(dds_error)?;
+    log::info!("subscribing {name} ({})", M::TYPE_NAME);
+    node.create_subscription::<M>(&topic, Some(sensor_qos()))
+        .map_err(dds_error)
+}
+
+fn publisher<M: RosMessage>(
+    node: &mut Node,
+    names: &Names,
+    relative: &str,
+) -> Result<Publisher<M>, NodeError> {
+    let name = names.topic(relative)?;
+    let topic = node
+        .create_topic(&name, type_name::<M>(), &output_qos())
+        .map_err(dds_error)?;
+    log::info!("publishing {name} ({})", M::TYPE_NAME);
+    node.create_publisher::<M>(&topic, Some(output_qos()))
+        .map_err(dds_error)
+}
+
+/// Wall-clock ROS time for the diagnostics header (the filter's outputs carry the input
+/// stamps instead).
+fn wall_time() -> Time {
+    let d = SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .unwrap_or_default();
+    Time {
+        sec: i32::try_from(d.as_secs()).unwrap_or(i32::MAX),
+        nanosec: d.subsec_nanos(),
+    }
+}
+
+enum Event {
+    Imu(Result<Imu, String>),
+    Gnss(Result<GnssMeasurements, String>),
+    Fix(Result<NavSatFix, String>),
+    Tick,
+}
+
+struct Outputs {
+    odometry: Publisher<Odometry>,
+    fix: Publisher<NavSatFix>,
+    noise: Publisher<NoiseEstimates>,
+    log: LogLimiter,
+}
+
+impl Outputs {
+    fn publish(&mut self, msgs: Vec<OutMsg>) {
+        for m in msgs {
+            let result = match m {
+                OutMsg::Odometry(o) => self.odometry.publish(*o).map_err(|e| format!("{e:?}")),
+                OutMsg::Fix(f) => self.fix.publish(f).map_err(|e| format!("{e:?}")),
+                OutMsg::Noise(n) => self.noise.publish(n).map_err(|e| format!("{e:?}")),
+            };
+            if let Err(e) = result {
+                self.log.warn("publish", &format!("publish failed: {e}"));
+            }
+        }
+    }
+}
+
+/// Runs the node until the process is stopped (or the DDS streams end).
+pub fn run(args: &NodeArgs, config: Config, domain_id: u16) -> Result<(), NodeError> {
+    let context =
+        Context::with_options(ContextOptions::new().domain_id(domain_id)).map_err(dds_error)?;
+    let node_name = NodeName::new(&args.namespace, &args.node_name).map_err(dds_error)?;
+    let mut node = context
+        .new_node(
+            node_name,
+            NodeOptions::new()
+                .enable_rosout(false)
+                .start_parameter_services(false),
+        )
+        .map_err(dds_error)?;
+    let names = Names { args };
+    let imu_sub = subscription::<Imu>(&mut node, &names, "imu")?;
+    let gnss_sub = subscription::<GnssMeasurements>(&mut node, &names, "gnss/measurements")?;
+    let fix_sub = subscription::<NavSatFix>(&mut node, &names, "gnss/fix")?;
+    let mut outputs = Outputs {
+        odometry: publisher(&mut node, &names, "odometry")?,
+        fix: publisher(&mut node, &names, "fix")?,
+        noise: publisher(&mut node, &names, "~/noise_estimates")?,
+        log: LogLimiter::default(),
+    };
+    let diagnostics = publisher::<DiagnosticArray>(&mut node, &names, "/diagnostics")?;
+    log::info!(
+        "{} running filter variant {} on DDS domain {domain_id}",
+        node.fully_qualified_name(),
+        config.filter.variant.as_str()
+    );
+    let mut core = NodeCore::new(config);
+
+    let imu = imu_sub.async_stream().map(|r| Event::Imu(decoded(r)));
+    let gnss = gnss_sub.async_stream().map(|r| Event::Gnss(decoded(r)));
+    let fix = fix_sub.async_stream().map(|r| Event::Fix(decoded(r)));
+    let tick = smol::Timer::interval(DIAGNOSTICS_PERIOD).map(|_| Event::Tick);
+    let events = stream::select(stream::select(imu, gnss), stream::select(fix, tick));
+    let mut events = std::pin::pin!(events);
+    let fqn = node.fully_qualified_name();
+
+    smol::block_on(async {
+        while let Some(event) = events.next().await {
+            let msgs = match event {
+                Event::Imu(Ok(m)) => core.on_imu(&m),
+                Event::Gnss(Ok(m)) => core.on_gnss(&m),
+                Event::Fix(Ok(m)) => core.on_fix(&m),
+                Event::Imu(Err(e)) => undecodable(&mut core, "imu", &e),
+                Event::Gnss(Err(e)) => undecodable(&mut core, "gnss/measurements", &e),
+                Event::Fix(Err(e)) => undecodable(&mut core, "gnss/fix", &e),
+                Event::Tick => {
+                    let report = core.diagnostics(&fqn, wall_time());
+                    if let Err(e) = diagnostics.publish(report) {
+                        log::warn!("publishing diagnostics failed: {e:?}");
+                    }
+                    Vec::new()
+                }
+            };
+            outputs.publish(msgs);
+        }
+    });
+    Ok(())
+}
+
+fn decoded<M>(r: ReadResult<(M, MessageInfo)>) -> Result<M, String> {
+    r.map(|(m, _)| m).map_err(|e| format!("{e:?}"))
+}
+
+fn undecodable(core: &mut NodeCore, topic: &str, error: &str) -> Vec<OutMsg> {
+    core.on_undecodable(topic, error);
+    Vec::new()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn domain_id_parsing() {
+        assert_eq!(domain_id_from(None).unwrap(), 0);
+        assert_eq!(domain_id_from(Some("")).unwrap(), 0);
+        assert_eq!(domain_id_from(Some("42")).unwrap(), 42);
+        assert!(domain_id_from(Some("233")).is_err());
+        assert!(domain_id_from(Some("x")).is_err());
+    }
+
+    #[test]
+    fn dds_type_names_match_the_messages() {
+        assert_eq!(type_name::<Imu>().dds_msg_type(), Imu::DDS_TYPE_NAME);
+        assert_eq!(
+            type_name::<GnssMeasurements>().dds_msg_type(),
+            GnssMeasurements::DDS_TYPE_NAME
+        );
+        assert_eq!(
+            type_name::<DiagnosticArray>().dds_msg_type(),
+            DiagnosticArray::DDS_TYPE_NAME
+        );
+    }
+}

@@ -1,0 +1,342 @@
+//! The `gnss_ins_node` binary over DDS: a second participant publishes a simulated static
+//! receiver and checks the node's Odometry against the truth.
+//!
+//! DDS traffic must stay on this machine: each test re-executes itself inside a private
+//! network namespace that has only loopback (`unshare -n`, needs root), where RustDDS
+//! discovery still works between processes of the namespace.
+
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use adaptive_gnss_ins::earth::{self, Llh};
+use adaptive_gnss_ins::ros::convert::seconds_to_time;
+use adaptive_gnss_ins::ros::msg::{DiagnosticArray, GnssMeasurements, Imu, Odometry, RosMessage};
+use adaptive_gnss_ins::ros::outbound;
+use adaptive_gnss_ins::sim::{Scenario, SimEvent};
+use ros2_client::{
+    Context, ContextOptions, MessageTypeName, Name, NodeName, NodeOptions, QosProfile,
+};
+
+const IN_NETNS: &str = "GNSS_INS_NODE_TEST_IN_NETNS";
+const DOMAIN_ID: u16 = 17;
+/// Position budget of the ekf preset on a static receiver after a minute of 1 Hz GNSS,
+/// the same as tests/engine_static.rs (three times the filter's own 3D sigma).
+const MAX_STATIC_POSITION_ERR_M: f64 = 7.0;
+/// Scenario seconds streamed, and how much faster than real time.
+const STREAM_S: f64 = 60.0;
+const SPEED_UP: f64 = 20.0;
+
+/// Runs the test `name` of this binary again inside a loopback-only network namespace.
+/// Returns false when already inside (the caller then does the real work).
+fn reexec_in_private_netns(name: &str) -> bool {
+    if std::env::var_os(IN_NETNS).is_some() {
+        return false;
+    }
+    let probe = Command::new("unshare").arg("--version").output();
+    assert!(
+        probe.is_ok_and(|o| o.status.success()),
+        "this test needs `unshare` (util-linux) and root to run DDS in a private network namespace"
+    );
+    let exe = std::env::current_exe().unwrap();
+    let status = Command::new("unshare")
+        .args(["-n", "sh", "-c", "ip link set lo up && exec \"$0\" \"$@\""])
+        .arg(exe)
+        .args([name, "--exact", "--nocapture", "--test-threads=1"])
+        .env(IN_NETNS, "1")
+        .status()
+        .unwrap();
+    assert!(
+        status.success(),
+        "{name} failed inside the network namespace"
+    );
+    true
+}
+
+struct KillOnDrop(Child);
+
+impl Drop for KillOnDrop {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+fn type_name<M: RosMessage>() -> MessageTypeName {
+    let parts: Vec<&str> = M::TYPE_NAME.split('/').collect();
+    MessageTypeName::new(parts[0], parts[2])
+}
+
+#[test]
+fn node_estimates_a_static_receiver() {
+    if reexec_in_private_netns("node_estimates_a_static_receiver") {
+        return;
+    }
+    let scenario = Scenario::builtin("static", 3).unwrap();
+    let spec = &scenario.spec().trajectory;
+    let truth = Llh::from_degrees(spec.start_lat_deg, spec.start_lon_deg, spec.start_height_m);
+    let params = concat!(env!("CARGO_MANIFEST_DIR"), "/params/ekf.yaml");
+    let datum = format!(
+        "output.datum_llh_deg_m:=[{}, {}, {}]",
+        spec.start_lat_deg, spec.start_lon_deg, spec.start_height_m
+    );
+    let node = Command::new(env!("CARGO_BIN_EXE_gnss_ins_node"))
+        .args(["--ros-args", "--params-file", params])
+        .args(["-p", "init.heading_deg:=0.0", "-p", &datum])
+        .args(["-r", "__ns:=/test", "-r", "imu:=imu/data"])
+        .env("ROS_DOMAIN_ID", DOMAIN_ID.to_string())
+        .env("RUST_LOG", "info,rustdds=error,ros2_client=warn")
+        .stdin(Stdio::null())
+        .spawn()
+        .unwrap();
+    let _node = KillOnDrop(node);
+
+    let context = Context::with_options(ContextOptions::new().domain_id(DOMAIN_ID)).unwrap();
+    let mut peer = context
+        .new_node(
+            NodeName::new("/test", "stream_player").unwrap(),
+            NodeOptions::new()
+                .enable_rosout(false)
+                .start_parameter_services(false),
+        )
+        .unwrap();
+    let reliable = QosProfile::publisher_default()
+        .history(ros2_client::qos::History::KeepLast { depth: 20_000 });
+    let topic = |peer: &mut ros2_client::Node, name: &str, t: MessageTypeName| {
+        peer.create_topic(&Name::parse(name).unwrap(), t, &reliable)
+            .unwrap()
+    };
+    let imu_topic = topic(&mut peer, "/test/imu/data", type_name::<Imu>());
+    let gnss_topic = topic(
+        &mut peer,
+        "/test/gnss/measurements",
+        type_name::<GnssMeasurements>(),
+    );
+    let odom_topic = topic(&mut peer, "/test/odometry", type_name::<Odometry>());
+    let diag_topic = topic(&mut peer, "/diagnostics", type_name::<DiagnosticArray>());
+    let imu_pub = peer.create_publisher::<Imu>(&imu_topic, None).unwrap();
+    let gnss_pub = peer
+        .create_publisher::<GnssMeasurements>(&gnss_topic, None)
+        .unwrap();
+    let odom_sub = peer
+        .create_subscription::<Odometry>(&odom_topic, None)
+        .unwrap();
+    let diag_sub = peer
+        .create_subscription::<DiagnosticArray>(&diag_topic, None)
+        .unwrap();
+    let spinner = peer.spinner().unwrap();
+    std::thread::spawn(move || smol::block_on(spinner.spin()));
+
+    // Discovery: both of our publishers matched by the node's subscriptions.
+    let matched = smol::block_on(async {
+        let wait = async {
+            imu_pub.wait_for_subscription(&peer).await;
+            gnss_pub.wait_for_subscription(&peer).await;
+            odom_sub.wait_for_publisher(&peer).await;
+            true
+        };
+        futures::select! {
+            ok = futures::FutureExt::fuse(wait) => ok,
+            _ = futures::FutureExt::fuse(smol::Timer::after(Duration::from_secs(20))) => false,
+        }
+    });
+    assert!(matched, "the node's topics were not discovered within 20 s");
+
+    // One bad IMU sample first: counted and dropped, the node stays up.
+    let bad: Imu = outbound::imu(
+        &adaptive_gnss_ins::ins::ImuSample {
+            t_s: 0.0,
+            w_ib_b_rad_s: nalgebra::Vector3::new(f64::NAN, 0.0, 0.0),
+            f_ib_b_m_s2: nalgebra::Vector3::zeros(),
+        },
+        seconds_to_time(0.0).unwrap(),
+        "imu_link",
+    );
+    // An empty GNSS epoch, rejected by the engine for having no satellites.
+    let empty = GnssMeasurements::default();
+    // Our side having matched does not mean the node's readers have matched our writers
+    // yet (best effort drops what it sends before): repeat the bad messages until the
+    // node's diagnostics count both, which proves both input paths are up before streaming.
+    let key_value = |d: &DiagnosticArray, key: &str| {
+        d.status[0]
+            .values
+            .iter()
+            .find(|kv| kv.key == key)
+            .and_then(|kv| kv.value.parse::<u64>().ok())
+    };
+    let deadline = Instant::now() + Duration::from_secs(20);
+    let (mut bad_counted, mut empty_counted) = (0, 0);
+    while bad_counted == 0 || empty_counted == 0 {
+        assert!(
+            Instant::now() < deadline,
+            "the node never reported the bad IMU sample and the empty GNSS epoch"
+        );
+        imu_pub.publish(bad.clone()).unwrap();
+        gnss_pub.publish(empty.clone()).unwrap();
+        std::thread::sleep(Duration::from_millis(250));
+        while let Ok(Some((d, _))) = diag_sub.take() {
+            bad_counted = key_value(&d, "unconvertible_imu").unwrap_or(0);
+            empty_counted = key_value(&d, "rejected_gnss_no_satellites").unwrap_or(0);
+        }
+    }
+    let stream = |until_s: f64| {
+        let start = Instant::now();
+        let (mut imu_sent, mut gnss_sent) = (0u64, 0u64);
+        for event in scenario.events() {
+            let event = event.unwrap();
+            let t_s = event.t_s();
+            if t_s > until_s {
+                break;
+            }
+            let due = Duration::from_secs_f64(t_s / SPEED_UP);
+            if let Some(wait) = due.checked_sub(start.elapsed()) {
+                std::thread::sleep(wait);
+            }
+            let stamp = seconds_to_time(t_s).unwrap();
+            match event {
+                SimEvent::Imu(s) => {
+                    imu_sent += 1;
+                    imu_pub
+                        .publish(outbound::imu(&s, stamp, "imu_link"))
+                        .unwrap()
+                }
+                SimEvent::Gnss { epoch, .. } => {
+                    gnss_sent += 1;
+                    gnss_pub
+                        .publish(outbound::gnss_measurements(&epoch, 0, stamp, "gnss"))
+                        .unwrap()
+                }
+                _ => {}
+            }
+        }
+        (imu_sent, gnss_sent)
+    };
+    let (imu_sent, gnss_sent) = stream(STREAM_S);
+
+    // Collect what the node published.
+    let deadline = Instant::now() + Duration::from_secs(3);
+    let mut odometry = Vec::new();
+    let mut last_diagnostics = None;
+    while Instant::now() < deadline {
+        while let Ok(Some((o, _))) = odom_sub.take() {
+            odometry.push(o);
+        }
+        while let Ok(Some((d, _))) = diag_sub.take() {
+            last_diagnostics = Some(d);
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    // One Odometry per IMU sample from the initialization at 1 s: about 5900.
+    assert!(
+        odometry.len() > 5000,
+        "only {} Odometry messages received",
+        odometry.len()
+    );
+    for o in &odometry {
+        let p = &o.pose.pose.position;
+        assert!(
+            [p.x, p.y, p.z]
+                .iter()
+                .chain(o.pose.covariance.iter())
+                .all(|v| v.is_finite()),
+            "non-finite Odometry {o:?}"
+        );
+        assert_eq!(o.header.frame_id, "map");
+        assert_eq!(o.child_frame_id, "base_link");
+    }
+    let last = odometry.last().unwrap();
+    let p = &last.pose.pose.position;
+    let truth_enu = earth::llh_to_enu(&truth, &truth);
+    let error_m = (nalgebra::Vector3::new(p.x, p.y, p.z) - truth_enu).norm();
+    eprintln!(
+        "{} Odometry messages; last at t = {} s, position error {error_m:.2} m",
+        odometry.len(),
+        last.header.stamp.sec
+    );
+    assert!(
+        error_m < MAX_STATIC_POSITION_ERR_M,
+        "position error {error_m} m"
+    );
+    assert!(
+        last.header.stamp.sec as f64 > STREAM_S - 2.0,
+        "stream not followed to its end"
+    );
+
+    let diagnostics = last_diagnostics.expect("no /diagnostics received");
+    let value = |key: &str| {
+        diagnostics.status[0]
+            .values
+            .iter()
+            .find(|kv| kv.key == key)
+            .map(|kv| kv.value.clone())
+    };
+    eprintln!("diagnostics: {:?}", diagnostics.status[0].values);
+    assert_eq!(value("phase").as_deref(), Some("running"));
+    let unconvertible: u64 = value("unconvertible_imu").unwrap().parse().unwrap();
+    let received: u64 = value("imu_received").unwrap().parse().unwrap();
+    assert!(unconvertible >= bad_counted, "the bad samples are counted");
+    assert_eq!(
+        received - unconvertible,
+        imu_sent,
+        "every good IMU sample arrived"
+    );
+    let empty_rejected: u64 = value("rejected_gnss_no_satellites")
+        .unwrap()
+        .parse()
+        .unwrap();
+    let gnss_received: u64 = value("gnss_received").unwrap().parse().unwrap();
+    assert_eq!(
+        gnss_received - empty_rejected,
+        gnss_sent,
+        "every GNSS epoch arrived"
+    );
+    assert_eq!(value("time_jump_resets").as_deref(), Some("0"));
+
+    // The bag plays again from its start: the node resets once and carries on.
+    stream(5.0);
+    let deadline = Instant::now() + Duration::from_secs(3);
+    let mut resets = None;
+    let mut after = 0;
+    while Instant::now() < deadline {
+        while let Ok(Some((o, _))) = odom_sub.take() {
+            assert!(o.pose.pose.position.x.is_finite(), "{o:?}");
+            after += 1;
+        }
+        while let Ok(Some((d, _))) = diag_sub.take() {
+            resets = d.status[0]
+                .values
+                .iter()
+                .find(|kv| kv.key == "time_jump_resets")
+                .map(|kv| kv.value.clone());
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    eprintln!("{after} Odometry messages after the time jump");
+    assert_eq!(resets.as_deref(), Some("1"));
+    assert!(after > 0, "no Odometry after the reset");
+}
+
+#[test]
+fn unknown_argument_is_rejected_with_a_clear_message() {
+    let out = Command::new(env!("CARGO_BIN_EXE_gnss_ins_node"))
+        .args(["--ros-args", "--bogus"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("unknown argument `--bogus`"), "{stderr}");
+}
+
+#[test]
+fn params_file_for_another_node_is_rejected() {
+    let params = concat!(env!("CARGO_MANIFEST_DIR"), "/params/ekf.yaml");
+    let out = Command::new(env!("CARGO_BIN_EXE_gnss_ins_node"))
+        .args(["--ros-args", "--params-file", params, "-r", "__node:=other"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("does not address node `/other`"),
+        "{stderr}"
+    );
+}
