@@ -5,18 +5,14 @@
 //! two-sided 95 % χ² interval on at least 90 % of the epochs.
 
 use adaptive_gnss_ins::config::{Config, FilterVariant};
-use adaptive_gnss_ins::earth;
 use adaptive_gnss_ins::engine::{Engine, Output, StatusEvent};
 use adaptive_gnss_ins::eval;
-use adaptive_gnss_ins::sim::constellation::{
-    AtmosphereTruth, GpsConstellation, ObservationNoise, ReceiverTruth,
-};
+use adaptive_gnss_ins::sim::constellation::GpsConstellation;
 use adaptive_gnss_ins::sim::{ImuErrorModel, ImuErrorSpec, Trajectory};
 
 mod support;
 use rand_chacha::rand_core::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use rand_distr::{Distribution, Normal};
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 use support::drive::drive;
 
@@ -112,12 +108,7 @@ fn run_drive(config: Config) -> Metrics {
     let imu_rate_hz = 100.0;
     let mut imu_errors = ImuErrorModel::new(&ImuErrorSpec::default(), imu_rate_hz, 42).unwrap();
     let constellation = GpsConstellation::augmented(1);
-    let atmosphere = AtmosphereTruth {
-        report_delays: true,
-        ..AtmosphereTruth::vacuum()
-    };
     let mut rng = ChaCha8Rng::seed_from_u64(7);
-    let unit = Normal::new(0.0, 1.0).unwrap();
     let (clock0_m, drift_mps) = (3_000.0, -25.0);
     let mut engine = Engine::new(config);
     let mut scored = Vec::new();
@@ -127,26 +118,13 @@ fn run_drive(config: Config) -> Metrics {
         let measured = imu_errors.corrupt(&truth.imu);
         let mut outputs = engine.push_imu(&measured).unwrap();
         if (t - t.round()).abs() < 1e-9 {
-            let rx = ReceiverTruth {
-                pos_ecef_m: earth::llh_to_ecef(&truth.nav.p),
-                vel_ecef_mps: earth::rot_ecef_to_enu(&truth.nav.p).transpose() * truth.nav.v_n,
+            let receiver = support::Receiver {
+                p: &truth.nav.p,
+                v_n: truth.nav.v_n,
                 clock_bias_m: clock0_m + drift_mps * t,
                 clock_drift_mps: drift_mps,
             };
-            let mut epoch = constellation
-                .simulate_epoch(t, &rx, &atmosphere, 10f64.to_radians(), |_| {
-                    ObservationNoise::default()
-                })
-                .unwrap();
-            for sat in &mut epoch.satellites {
-                let up = earth::rot_ecef_to_enu(&truth.nav.p)
-                    * (sat.sat_pos_ecef_m - rx.pos_ecef_m).normalize();
-                let scale = 1.0 / up[2].asin().max(10f64.to_radians()).sin();
-                sat.pseudorange_m += 3.0 * scale * unit.sample(&mut rng);
-                if let Some(r) = sat.pseudorange_rate_mps.as_mut() {
-                    *r += 0.1 * scale * unit.sample(&mut rng);
-                }
-            }
+            let epoch = support::noisy_epoch(&constellation, &mut rng, t, &receiver);
             outputs.extend(engine.push_gnss(epoch).unwrap());
             // Score once per second, at the solution right after the update.
             if let Some(state) = engine.state() {

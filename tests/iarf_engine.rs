@@ -14,9 +14,7 @@
 use adaptive_gnss_ins::config::{Config, Coupling, FilterVariant};
 use adaptive_gnss_ins::earth;
 use adaptive_gnss_ins::engine::{Engine, EpochReport, GnssFix, Output, StatusEvent};
-use adaptive_gnss_ins::sim::constellation::{
-    AtmosphereTruth, GpsConstellation, ObservationNoise, ReceiverTruth,
-};
+use adaptive_gnss_ins::sim::constellation::GpsConstellation;
 use adaptive_gnss_ins::sim::{ImuErrorModel, ImuErrorSpec, Trajectory};
 
 mod support;
@@ -87,10 +85,6 @@ fn run(config: Config, laps: usize, feed: Feed) -> Run {
     let imu_rate_hz = 100.0;
     let mut imu_errors = ImuErrorModel::new(&ImuErrorSpec::default(), imu_rate_hz, 42).unwrap();
     let constellation = GpsConstellation::augmented(1);
-    let atmosphere = AtmosphereTruth {
-        report_delays: true,
-        ..AtmosphereTruth::vacuum()
-    };
     let mut rng = ChaCha8Rng::seed_from_u64(7);
     let mut outlier_rng = ChaCha8Rng::seed_from_u64(11);
     let unit = Normal::new(0.0, 1.0).unwrap();
@@ -133,27 +127,13 @@ fn run(config: Config, laps: usize, feed: Feed) -> Run {
                     outputs.extend(engine.push_fix(fix).unwrap());
                 }
                 Feed::Ranges => {
-                    let rx = ReceiverTruth {
-                        pos_ecef_m: earth::llh_to_ecef(&truth.nav.p),
-                        vel_ecef_mps: earth::rot_ecef_to_enu(&truth.nav.p).transpose()
-                            * truth.nav.v_n,
+                    let receiver = support::Receiver {
+                        p: &truth.nav.p,
+                        v_n: truth.nav.v_n,
                         clock_bias_m: clock0_m + drift_mps * t,
                         clock_drift_mps: drift_mps,
                     };
-                    let mut epoch = constellation
-                        .simulate_epoch(t, &rx, &atmosphere, 10f64.to_radians(), |_| {
-                            ObservationNoise::default()
-                        })
-                        .unwrap();
-                    for sat in &mut epoch.satellites {
-                        let up = earth::rot_ecef_to_enu(&truth.nav.p)
-                            * (sat.sat_pos_ecef_m - rx.pos_ecef_m).normalize();
-                        let scale = 1.0 / up[2].asin().max(10f64.to_radians()).sin();
-                        sat.pseudorange_m += 3.0 * scale * unit.sample(&mut rng);
-                        if let Some(r) = sat.pseudorange_rate_mps.as_mut() {
-                            *r += 0.1 * scale * unit.sample(&mut rng);
-                        }
-                    }
+                    let epoch = support::noisy_epoch(&constellation, &mut rng, t, &receiver);
                     outputs.extend(engine.push_gnss(epoch).unwrap());
                 }
             }

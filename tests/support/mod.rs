@@ -53,39 +53,61 @@ impl StaticScenario {
 
     /// A GNSS epoch at `t_s` with noise of the default σ model (3 m, 0.1 m/s at zenith).
     pub fn gnss(&mut self, t_s: f64) -> GnssEpoch {
-        let truth = ReceiverTruth {
-            pos_ecef_m: earth::llh_to_ecef(&self.position),
-            vel_ecef_mps: Vector3::zeros(),
-            clock_bias_m: self.clock_bias_m + self.clock_drift_mps * t_s,
+        let clock_bias_m = self.clock_bias_m + self.clock_drift_mps * t_s;
+        let receiver = Receiver {
+            p: &self.position,
+            v_n: Vector3::zeros(),
+            clock_bias_m,
             clock_drift_mps: self.clock_drift_mps,
         };
-        let unit = Normal::new(0.0, 1.0).unwrap();
-        let rng = &mut self.rng;
-        let constellation = &self.constellation;
-        // No atmosphere, and the observations say so (delays present and zero), so the
-        // filter applies no troposphere model.
-        let atmosphere = AtmosphereTruth {
-            report_delays: true,
-            ..AtmosphereTruth::vacuum()
-        };
-        // Noise σ of the filter's model needs the elevation; draw zenith-scaled noise and
-        // scale it afterwards with the elevation seen from the true position.
-        let mut epoch = constellation
-            .simulate_epoch(t_s, &truth, &atmosphere, 10f64.to_radians(), |_| {
-                ObservationNoise::default()
-            })
-            .unwrap();
-        for sat in &mut epoch.satellites {
-            let los = (sat.sat_pos_ecef_m - truth.pos_ecef_m).normalize();
-            let up = earth::rot_ecef_to_enu(&self.position) * los;
-            let scale = 1.0 / up[2].asin().max(10f64.to_radians()).sin();
-            sat.pseudorange_m += 3.0 * scale * unit.sample(rng);
-            if let Some(r) = sat.pseudorange_rate_mps.as_mut() {
-                *r += 0.1 * scale * unit.sample(rng);
-            }
-        }
-        epoch
+        noisy_epoch(&self.constellation, &mut self.rng, t_s, &receiver)
     }
+}
+
+/// The true receiver state behind a simulated epoch.
+pub struct Receiver<'a> {
+    pub p: &'a Llh,
+    /// ENU velocity (m/s).
+    pub v_n: Vector3<f64>,
+    pub clock_bias_m: f64,
+    pub clock_drift_mps: f64,
+}
+
+/// A GPS epoch at `t_s` above a 10° mask with white noise of the filter's default σ model
+/// (3 m and 0.1 m/s at the zenith, divided by the sine of the elevation). No atmosphere,
+/// and the observations say so (delays present and zero), so the filter applies none.
+pub fn noisy_epoch(
+    constellation: &GpsConstellation,
+    rng: &mut ChaCha8Rng,
+    t_s: f64,
+    receiver: &Receiver,
+) -> GnssEpoch {
+    let truth = ReceiverTruth {
+        pos_ecef_m: earth::llh_to_ecef(receiver.p),
+        vel_ecef_mps: earth::rot_ecef_to_enu(receiver.p).transpose() * receiver.v_n,
+        clock_bias_m: receiver.clock_bias_m,
+        clock_drift_mps: receiver.clock_drift_mps,
+    };
+    let unit = Normal::new(0.0, 1.0).unwrap();
+    let atmosphere = AtmosphereTruth {
+        report_delays: true,
+        ..AtmosphereTruth::vacuum()
+    };
+    let mut epoch = constellation
+        .simulate_epoch(t_s, &truth, &atmosphere, 10f64.to_radians(), |_| {
+            ObservationNoise::default()
+        })
+        .unwrap();
+    for sat in &mut epoch.satellites {
+        let up = earth::rot_ecef_to_enu(receiver.p)
+            * (sat.sat_pos_ecef_m - truth.pos_ecef_m).normalize();
+        let scale = 1.0 / up[2].asin().max(10f64.to_radians()).sin();
+        sat.pseudorange_m += 3.0 * scale * unit.sample(rng);
+        if let Some(r) = sat.pseudorange_rate_mps.as_mut() {
+            *r += 0.1 * scale * unit.sample(rng);
+        }
+    }
+    epoch
 }
 
 /// The default configuration with the heading given (a static receiver cannot find it)
