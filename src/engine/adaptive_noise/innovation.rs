@@ -12,7 +12,7 @@ use crate::adaptive::innovation::{
 use crate::config::Config;
 use crate::gnss::SatId;
 
-use super::{variance_bounds, NoiseVerdict, Observable, ScalarMeasurement};
+use super::{NoiseVerdict, Observable, ScalarMeasurement, VarianceBounds};
 
 #[derive(Debug, Clone)]
 struct Track {
@@ -25,7 +25,7 @@ struct Track {
 #[derive(Debug, Clone)]
 pub struct InnovationNoise {
     options: InnovationOptions,
-    bounds: [(f64, f64); 2],
+    bounds: VarianceBounds,
     max_gap_s: f64,
     tracks: HashMap<(SatId, Observable), Track>,
 }
@@ -42,10 +42,7 @@ impl InnovationNoise {
         };
         Self {
             options,
-            bounds: [
-                variance_bounds(config, Observable::Pseudorange),
-                variance_bounds(config, Observable::PseudorangeRate),
-            ],
+            bounds: VarianceBounds::new(config),
             max_gap_s: a.max_epoch_gap_s,
             tracks: HashMap::new(),
         }
@@ -63,10 +60,7 @@ impl InnovationNoise {
     }
 
     fn variance(&mut self, t_s: f64, row: &ScalarMeasurement, learn: bool) -> NoiseVerdict {
-        let (r_min, r_max) = match row.observable {
-            Observable::Pseudorange => self.bounds[0],
-            Observable::PseudorangeRate => self.bounds[1],
-        };
+        let (r_min, r_max) = self.bounds.of(row.observable);
         let track = match self.tracks.entry((row.sat, row.observable)) {
             std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
             std::collections::hash_map::Entry::Vacant(e) => {

@@ -159,18 +159,34 @@ impl NoiseModel {
     }
 }
 
-/// The variance bounds of the configuration for an observable.
-pub(crate) fn variance_bounds(config: &Config, observable: Observable) -> (f64, f64) {
-    let a = &config.adaptive;
-    match observable {
-        Observable::Pseudorange => (
-            a.pseudorange_sigma_min_m.powi(2),
-            a.pseudorange_sigma_max_m.powi(2),
-        ),
-        Observable::PseudorangeRate => (
-            a.pseudorange_rate_sigma_min_mps.powi(2),
-            a.pseudorange_rate_sigma_max_mps.powi(2),
-        ),
+/// The bounds of `adaptive.*` on an estimated variance, per observable.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct VarianceBounds {
+    pseudorange_m2: (f64, f64),
+    rate_m2_s2: (f64, f64),
+}
+
+impl VarianceBounds {
+    pub(crate) fn new(config: &Config) -> Self {
+        let a = &config.adaptive;
+        Self {
+            pseudorange_m2: (
+                a.pseudorange_sigma_min_m.powi(2),
+                a.pseudorange_sigma_max_m.powi(2),
+            ),
+            rate_m2_s2: (
+                a.pseudorange_rate_sigma_min_mps.powi(2),
+                a.pseudorange_rate_sigma_max_mps.powi(2),
+            ),
+        }
+    }
+
+    /// (minimum, maximum) variance of `observable`.
+    pub(crate) fn of(&self, observable: Observable) -> (f64, f64) {
+        match observable {
+            Observable::Pseudorange => self.pseudorange_m2,
+            Observable::PseudorangeRate => self.rate_m2_s2,
+        }
     }
 }
 

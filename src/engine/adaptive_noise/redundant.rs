@@ -24,7 +24,7 @@ use crate::adaptive::redundant::{
 use crate::config::Config;
 use crate::gnss::SatId;
 
-use super::{estimator_seed, variance_bounds, NoiseVerdict, Observable, ScalarMeasurement};
+use super::{estimator_seed, NoiseVerdict, Observable, ScalarMeasurement, VarianceBounds};
 
 /// What is remembered of a satellite's previous epoch.
 #[derive(Debug, Clone, Copy)]
@@ -45,7 +45,7 @@ struct Track {
 #[derive(Debug, Clone)]
 pub struct RedundantNoise {
     options: RedundantNoiseOptions,
-    bounds: [(f64, f64); 2],
+    bounds: VarianceBounds,
     max_gap_s: f64,
     tracks: HashMap<(SatId, Observable), Track>,
 }
@@ -69,19 +69,9 @@ impl RedundantNoise {
         };
         Self {
             options,
-            bounds: [
-                variance_bounds(config, Observable::Pseudorange),
-                variance_bounds(config, Observable::PseudorangeRate),
-            ],
+            bounds: VarianceBounds::new(config),
             max_gap_s: a.max_epoch_gap_s,
             tracks: HashMap::new(),
-        }
-    }
-
-    fn bounds(&self, observable: Observable) -> (f64, f64) {
-        match observable {
-            Observable::Pseudorange => self.bounds[0],
-            Observable::PseudorangeRate => self.bounds[1],
         }
     }
 
@@ -97,7 +87,7 @@ impl RedundantNoise {
     }
 
     fn variance(&mut self, t_s: f64, row: &ScalarMeasurement, learn: bool) -> NoiseVerdict {
-        let (r_min, r_max) = self.bounds(row.observable);
+        let (r_min, r_max) = self.bounds.of(row.observable);
         let options = RedundantNoiseOptions {
             seed: estimator_seed(self.options.seed, row.sat, row.observable),
             ..self.options.clone()

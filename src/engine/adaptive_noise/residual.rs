@@ -24,7 +24,7 @@ use crate::adaptive::residual_r::{ResidualCovarianceEstimator, ResidualCovarianc
 use crate::config::Config;
 use crate::gnss::SatId;
 
-use super::{variance_bounds, NoiseVerdict, Observable, ScalarMeasurement};
+use super::{NoiseVerdict, Observable, ScalarMeasurement, VarianceBounds};
 
 #[derive(Debug, Clone)]
 struct Track {
@@ -36,7 +36,7 @@ struct Track {
 #[derive(Debug, Clone)]
 pub struct ResidualNoise {
     options: ResidualCovarianceOptions,
-    bounds: [(f64, f64); 2],
+    bounds: VarianceBounds,
     max_gap_s: f64,
     tracks: HashMap<(SatId, Observable), Track>,
     fix: Option<Track>,
@@ -51,10 +51,7 @@ impl ResidualNoise {
                 min_samples: window,
                 ..ResidualCovarianceOptions::default()
             },
-            bounds: [
-                variance_bounds(config, Observable::Pseudorange),
-                variance_bounds(config, Observable::PseudorangeRate),
-            ],
+            bounds: VarianceBounds::new(config),
             max_gap_s: config.adaptive.max_epoch_gap_s,
             tracks: HashMap::new(),
             fix: None,
@@ -66,10 +63,7 @@ impl ResidualNoise {
     pub fn variances(&self, rows: &[ScalarMeasurement]) -> Vec<NoiseVerdict> {
         rows.iter()
             .map(|row| {
-                let (lo, hi) = match row.observable {
-                    Observable::Pseudorange => self.bounds[0],
-                    Observable::PseudorangeRate => self.bounds[1],
-                };
+                let (lo, hi) = self.bounds.of(row.observable);
                 match self
                     .tracks
                     .get(&(row.sat, row.observable))
