@@ -22,5 +22,5 @@ fi
 "${venv_dir}/bin/python" -m pip install --quiet --disable-pip-version-check \
     --requirement "${requirements}"
 
-"${venv_dir}/bin/python" -c "import rosbags"
+"${venv_dir}/bin/python" -c "import rosbags, cyclonedds.domain"
 echo "setup_test_peers: ready (${venv_dir}/bin/python)"

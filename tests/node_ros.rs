@@ -5,7 +5,9 @@
 //! network namespace that has only loopback (`unshare -n`, needs root), where RustDDS
 //! discovery still works between processes of the namespace.
 
-use std::process::{Child, Command, Stdio};
+mod netns_support;
+
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use adaptive_gnss_ins::earth::{self, Llh};
@@ -13,11 +15,11 @@ use adaptive_gnss_ins::ros::convert::seconds_to_time;
 use adaptive_gnss_ins::ros::msg::{DiagnosticArray, GnssMeasurements, Imu, Odometry, RosMessage};
 use adaptive_gnss_ins::ros::outbound;
 use adaptive_gnss_ins::sim::{Scenario, SimEvent};
+use netns_support::{reexec_in_private_netns, KillOnDrop};
 use ros2_client::{
     Context, ContextOptions, MessageTypeName, Name, NodeName, NodeOptions, QosProfile,
 };
 
-const IN_NETNS: &str = "GNSS_INS_NODE_TEST_IN_NETNS";
 const DOMAIN_ID: u16 = 17;
 /// Position budget of the ekf preset on a static receiver after a minute of 1 Hz GNSS,
 /// the same as tests/engine_static.rs (three times the filter's own 3D sigma).
@@ -25,41 +27,6 @@ const MAX_STATIC_POSITION_ERR_M: f64 = 7.0;
 /// Scenario seconds streamed, and how much faster than real time.
 const STREAM_S: f64 = 60.0;
 const SPEED_UP: f64 = 20.0;
-
-/// Runs the test `name` of this binary again inside a loopback-only network namespace.
-/// Returns false when already inside (the caller then does the real work).
-fn reexec_in_private_netns(name: &str) -> bool {
-    if std::env::var_os(IN_NETNS).is_some() {
-        return false;
-    }
-    let probe = Command::new("unshare").arg("--version").output();
-    assert!(
-        probe.is_ok_and(|o| o.status.success()),
-        "this test needs `unshare` (util-linux) and root to run DDS in a private network namespace"
-    );
-    let exe = std::env::current_exe().unwrap();
-    let status = Command::new("unshare")
-        .args(["-n", "sh", "-c", "ip link set lo up && exec \"$0\" \"$@\""])
-        .arg(exe)
-        .args([name, "--exact", "--nocapture", "--test-threads=1"])
-        .env(IN_NETNS, "1")
-        .status()
-        .unwrap();
-    assert!(
-        status.success(),
-        "{name} failed inside the network namespace"
-    );
-    true
-}
-
-struct KillOnDrop(Child);
-
-impl Drop for KillOnDrop {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
 
 fn type_name<M: RosMessage>() -> MessageTypeName {
     let parts: Vec<&str> = M::TYPE_NAME.split('/').collect();

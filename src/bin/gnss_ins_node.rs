@@ -15,7 +15,7 @@ fn main() -> ExitCode {
     let level = cli.log_level.as_deref().unwrap_or("info");
     let filter = format!("{level},rustdds=error,ros2_client=warn");
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or(filter)).init();
-    let config = match node::params::load_config(&cli) {
+    let params = match node::params::load(&cli) {
         Ok(c) => c,
         Err(e) => return fail(&e),
     };
@@ -23,7 +23,12 @@ fn main() -> ExitCode {
         Ok(d) => d,
         Err(e) => return fail(&e),
     };
-    match node::run(&cli, config, domain_id) {
+    let rmw = std::env::var("RMW_IMPLEMENTATION").ok();
+    let dds = node::DdsOptions {
+        domain_id,
+        service_mapping: node::service_mapping_from(rmw.as_deref()),
+    };
+    match node::run(&cli, params, dds) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => fail(&e),
     }

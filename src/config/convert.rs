@@ -32,6 +32,9 @@ pub const M_S2_PER_UG: f64 = STANDARD_GRAVITY_M_S2 * 1e-6;
 /// Math note: fl(fl(h·k)/k) lies within two units in the last place of h, so when `si`
 /// came from a forward conversion, one of the five neighbours of `si / factor` tried here
 /// converts forward to exactly `si`. For other `si` the plain quotient is returned.
+/// Choice: when several neighbours convert to `si`, the one with the shortest decimal
+/// form is returned (15 deg stays 15, not 14.999999999999998), since the human value a
+/// person typed is the short one.
 pub fn si_to_human(si: f64, factor: f64) -> f64 {
     let quotient = si / factor;
     if !quotient.is_finite() || quotient == 0.0 {
@@ -41,7 +44,8 @@ pub fn si_to_human(si: f64, factor: f64) -> f64 {
     [0_i64, 1, -1, 2, -2]
         .into_iter()
         .map(|step| f64::from_bits(bits.wrapping_add_signed(step)))
-        .find(|candidate| candidate * factor == si)
+        .filter(|candidate| candidate * factor == si)
+        .min_by_key(|candidate| candidate.to_string().len())
         .unwrap_or(quotient)
 }
 
@@ -354,6 +358,13 @@ mod tests {
             human *= 1.0137;
         }
         assert_eq!(si_to_human(0.0, RAD_PER_DEG), 0.0);
+    }
+
+    #[test]
+    fn si_to_human_gives_back_the_short_value_typed() {
+        for h in [15.0, 12.5, 10.0, 0.3, 95.0] {
+            assert_eq!(si_to_human(h * RAD_PER_DEG, RAD_PER_DEG), h);
+        }
     }
 
     #[test]

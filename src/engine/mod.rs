@@ -22,6 +22,7 @@ pub mod loose_update;
 mod output;
 pub mod q_scaling;
 mod rejection;
+mod retune;
 pub mod robust_update;
 pub mod tight_update;
 
@@ -41,6 +42,7 @@ pub use output::{
     StatusEvent,
 };
 pub use rejection::{InputRejected, RejectionCounters, RejectionReason};
+pub use retune::{NotRuntimeTunable, RUNTIME_PARAMETERS};
 
 /// A measurement waiting for its time.
 #[derive(Debug, Clone, PartialEq)]

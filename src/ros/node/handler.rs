@@ -3,7 +3,7 @@
 
 use crate::config::Config;
 use crate::earth::Llh;
-use crate::engine::{Engine, Output, ResetReason, StatusEvent};
+use crate::engine::{Engine, NotRuntimeTunable, Output, ResetReason, StatusEvent};
 use crate::ins::ImuSample;
 use crate::ros::convert::{seconds_to_time, time_to_seconds};
 use crate::ros::msg::{
@@ -105,6 +105,12 @@ impl NodeCore {
     /// The engine (for its counters and phase).
     pub fn engine(&self) -> &Engine {
         &self.engine
+    }
+
+    /// Takes over a configuration that differs only in runtime parameters (see
+    /// [`Engine::retune`]); the filter keeps running.
+    pub fn retune(&mut self, config: Config) -> Result<(), NotRuntimeTunable> {
+        self.engine.retune(config)
     }
 
     /// Records a payload on `topic` that did not decode.

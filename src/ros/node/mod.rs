@@ -7,17 +7,19 @@
 
 pub mod handler;
 pub mod log_limit;
+mod param_docs;
+pub mod param_server;
 pub mod params;
+pub mod services;
 
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
-use futures::stream::{self, StreamExt};
+use futures::stream::{self, LocalBoxStream, StreamExt};
 use ros2_client::{
     qos::History, Context, ContextOptions, MessageInfo, MessageTypeName, Name, Node, NodeName,
-    NodeOptions, Publisher, QosProfile, ReadResult, Subscription,
+    NodeOptions, Publisher, QosProfile, ReadResult, ServiceMapping, Subscription,
 };
 
-use crate::config::Config;
 use crate::ros::args::NodeArgs;
 use crate::ros::msg::{
     DiagnosticArray, GnssMeasurements, Imu, NavSatFix, NoiseEstimates, Odometry, RosMessage, Time,
@@ -26,6 +28,10 @@ use crate::ros::names::resolve_remapped;
 
 pub use handler::{NodeCore, OutMsg};
 use log_limit::LogLimiter;
+use param_server::ParameterServer;
+use params::NodeParams;
+pub use services::service_mapping_from;
+use services::{ParamRequest, ParameterServices};
 
 /// Queue depth of the subscriptions and publishers.
 ///
@@ -138,7 +144,17 @@ enum Event {
     Imu(Result<Imu, String>),
     Gnss(Result<GnssMeasurements, String>),
     Fix(Result<NavSatFix, String>),
+    Param(ParamRequest),
     Tick,
+}
+
+/// How the node meets the DDS world: the domain and the service request/reply mapping.
+#[derive(Debug, Clone, Copy)]
+pub struct DdsOptions {
+    /// `ROS_DOMAIN_ID`.
+    pub domain_id: u16,
+    /// From `RMW_IMPLEMENTATION`, see [`service_mapping_from`].
+    pub service_mapping: ServiceMapping,
 }
 
 struct Outputs {
@@ -164,7 +180,8 @@ impl Outputs {
 }
 
 /// Runs the node until the process is stopped (or the DDS streams end).
-pub fn run(args: &NodeArgs, config: Config, domain_id: u16) -> Result<(), NodeError> {
+pub fn run(args: &NodeArgs, params: NodeParams, dds: DdsOptions) -> Result<(), NodeError> {
+    let domain_id = dds.domain_id;
     let context =
         Context::with_options(ContextOptions::new().domain_id(domain_id)).map_err(dds_error)?;
     let node_name = NodeName::new(&args.namespace, &args.node_name).map_err(dds_error)?;
@@ -187,19 +204,40 @@ pub fn run(args: &NodeArgs, config: Config, domain_id: u16) -> Result<(), NodeEr
         log: LogLimiter::default(),
     };
     let diagnostics = publisher::<DiagnosticArray>(&mut node, &names, "/diagnostics")?;
+    let services = ParameterServices::new(&mut node, dds.service_mapping)?;
+    let config = params.config;
     log::info!(
         "{} running filter variant {} on DDS domain {domain_id}",
         node.fully_qualified_name(),
         config.filter.variant.as_str()
     );
     let mut core = NodeCore::new(config);
+    let mut parameters = ParameterServer::new(params.use_sim_time);
 
-    let imu = imu_sub.async_stream().map(|r| Event::Imu(decoded(r)));
-    let gnss = gnss_sub.async_stream().map(|r| Event::Gnss(decoded(r)));
-    let fix = fix_sub.async_stream().map(|r| Event::Fix(decoded(r)));
-    let tick = smol::Timer::interval(DIAGNOSTICS_PERIOD).map(|_| Event::Tick);
-    let events = stream::select(stream::select(imu, gnss), stream::select(fix, tick));
-    let mut events = std::pin::pin!(events);
+    let mut sources: Vec<LocalBoxStream<'_, Event>> = vec![
+        imu_sub
+            .async_stream()
+            .map(|r| Event::Imu(decoded(r)))
+            .boxed_local(),
+        gnss_sub
+            .async_stream()
+            .map(|r| Event::Gnss(decoded(r)))
+            .boxed_local(),
+        fix_sub
+            .async_stream()
+            .map(|r| Event::Fix(decoded(r)))
+            .boxed_local(),
+        smol::Timer::interval(DIAGNOSTICS_PERIOD)
+            .map(|_| Event::Tick)
+            .boxed_local(),
+    ];
+    sources.extend(
+        services
+            .streams()
+            .into_iter()
+            .map(|s| s.map(Event::Param).boxed_local()),
+    );
+    let mut events = stream::select_all(sources);
     let fqn = node.fully_qualified_name();
 
     smol::block_on(async {
@@ -211,6 +249,10 @@ pub fn run(args: &NodeArgs, config: Config, domain_id: u16) -> Result<(), NodeEr
                 Event::Imu(Err(e)) => undecodable(&mut core, "imu", &e),
                 Event::Gnss(Err(e)) => undecodable(&mut core, "gnss/measurements", &e),
                 Event::Fix(Err(e)) => undecodable(&mut core, "gnss/fix", &e),
+                Event::Param(request) => {
+                    services.answer(request, &mut parameters, &mut core);
+                    Vec::new()
+                }
                 Event::Tick => {
                     let report = core.diagnostics(&fqn, wall_time());
                     if let Err(e) = diagnostics.publish(report) {

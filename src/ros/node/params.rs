@@ -20,6 +20,8 @@ pub enum ParamsError {
     },
     #[error(transparent)]
     Config(Box<ConfigError>),
+    #[error("use_sim_time must be true or false, not `{0}`")]
+    SimTime(String),
     #[error("-p {name}:={value}: {source}")]
     Override {
         name: String,
@@ -28,12 +30,58 @@ pub enum ParamsError {
     },
 }
 
-/// The standard ROS parameter every launch file may set.
+/// The standard ROS parameter every launch file may set: the node's time (the
+/// /diagnostics and /rosout stamps, the time since the last input) follows `/clock`.
 ///
-/// Choice: it is accepted and has no effect. The filter runs on the stamps of its inputs
-/// (so a bag replayed with `--clock` is processed on the bag's time either way) and its
-/// outputs carry those stamps; only the /diagnostics header uses the wall clock.
+/// It is the node's, not the core's: the filter runs on the stamps of its inputs either
+/// way (so a bag replayed with `--clock` is processed on the bag's time) and its outputs
+/// carry those stamps.
 pub const USE_SIM_TIME: &str = "use_sim_time";
+
+/// What the command line configures: the core's configuration and the node's own
+/// `use_sim_time`.
+#[derive(Debug, Clone)]
+pub struct NodeParams {
+    /// The engine's configuration.
+    pub config: Config,
+    /// Whether the node's time follows `/clock`.
+    pub use_sim_time: bool,
+}
+
+/// The `use_sim_time` of the params file and the `-p` overrides (the last one wins;
+/// default false).
+fn use_sim_time_from(args: &NodeArgs, params_text: Option<&str>) -> Result<bool, ParamsError> {
+    let mut value = false;
+    let document = params_text.and_then(|t| serde_yaml::from_str::<serde_yaml::Value>(t).ok());
+    if let Some(serde_yaml::Value::Mapping(nodes)) = document {
+        for (_, node) in nodes {
+            if let Some(v) = node
+                .get("ros__parameters")
+                .and_then(|p| p.get(USE_SIM_TIME))
+            {
+                value = v
+                    .as_bool()
+                    .ok_or_else(|| ParamsError::SimTime(format!("{v:?}")))?;
+            }
+        }
+    }
+    for (_, v) in args.parameters.iter().filter(|(n, _)| n == USE_SIM_TIME) {
+        value = serde_yaml::from_str::<bool>(v).map_err(|_| ParamsError::SimTime(v.clone()))?;
+    }
+    Ok(value)
+}
+
+/// The node's parameters of `args` where `params_text` is the content of
+/// `args.params_file` (None: no file).
+pub fn node_params_from(
+    args: &NodeArgs,
+    params_text: Option<&str>,
+) -> Result<NodeParams, ParamsError> {
+    Ok(NodeParams {
+        config: config_from(args, params_text)?,
+        use_sim_time: use_sim_time_from(args, params_text)?,
+    })
+}
 
 /// The configuration of `args` where `params_text` is the content of `args.params_file`
 /// (None: no file; the defaults of `params/ekf.yaml` apply).
@@ -106,8 +154,8 @@ fn check_node_key(text: &str, origin: &str, args: &NodeArgs) -> Result<(), Param
     Ok(())
 }
 
-/// Reads `args.params_file` (if any) and builds the configuration.
-pub fn load_config(args: &NodeArgs) -> Result<Config, ParamsError> {
+/// Reads `args.params_file` (if any) and builds the node's parameters.
+pub fn load(args: &NodeArgs) -> Result<NodeParams, ParamsError> {
     let text = match &args.params_file {
         Some(path) => Some(
             std::fs::read_to_string(path).map_err(|source| ParamsError::Read {
@@ -117,7 +165,7 @@ pub fn load_config(args: &NodeArgs) -> Result<Config, ParamsError> {
         ),
         None => None,
     };
-    config_from(args, text.as_deref())
+    node_params_from(args, text.as_deref())
 }
 
 #[cfg(test)]
@@ -168,7 +216,7 @@ mod tests {
     }
 
     #[test]
-    fn use_sim_time_is_accepted_and_ignored() {
+    fn use_sim_time_is_the_nodes_not_the_cores() {
         let file = FILE.replace(
             "ros__parameters:\n",
             "ros__parameters:\n    use_sim_time: true\n",
@@ -179,6 +227,17 @@ mod tests {
         );
         let c = config_from(&args(&["-p", "use_sim_time:=true"]), Some(&file)).unwrap();
         assert_eq!(c.filter.variant.as_str(), "ermakf");
+        let p = node_params_from(&args(&[]), Some(&file)).unwrap();
+        assert!(p.use_sim_time, "from the file");
+        let p = node_params_from(&args(&["-p", "use_sim_time:=false"]), Some(&file)).unwrap();
+        assert!(!p.use_sim_time, "-p wins over the file");
+        assert!(
+            !node_params_from(&args(&[]), Some(FILE))
+                .unwrap()
+                .use_sim_time
+        );
+        let e = node_params_from(&args(&["-p", "use_sim_time:=maybe"]), Some(FILE));
+        assert!(matches!(e, Err(ParamsError::SimTime(_))));
         // Files without it keep the loader's line numbers in errors.
         let bad = FILE.replace("ermakf", "no_such_variant");
         let e = config_from(&args(&[]), Some(&bad)).unwrap_err().to_string();
