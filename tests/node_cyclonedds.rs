@@ -110,13 +110,14 @@ fn run_peer(python: &Path, extra_args: &[&str]) {
 }
 
 /// The peer first lists, reads, describes and sets parameters through the node's
-/// parameter services (leaving them as they were), then plays the bag.
+/// parameter services (leaving them as they were), then plays the bag with its time on
+/// /clock (the node runs with use_sim_time) and checks /rosout too.
 #[test]
 fn cyclonedds_peer_sets_parameters_and_plays_a_bag_into_the_node() {
     let python = venv_python();
     if reexec_in_private_netns("cyclonedds_peer_sets_parameters_and_plays_a_bag_into_the_node") {
         return;
     }
-    let _node = start_node(&[]);
-    run_peer(&python, &["--parameters"]);
+    let _node = start_node(&["-p", "use_sim_time:=true"]);
+    run_peer(&python, &["--parameters", "--sim-time"]);
 }

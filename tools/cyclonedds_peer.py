@@ -2,7 +2,7 @@
 """Independent DDS peer of gnss_ins_node on Eclipse Cyclone DDS (PyPI `cyclonedds`).
 
 Usage: cyclonedds_peer.py --bag BAG --namespace NS --node NAME [--speed X]
-                          [--variant NAME] [--golden CSV] [--parameters]
+                          [--variant NAME] [--golden CSV] [--parameters] [--sim-time]
 
 Plays the /imu and /gnss/measurements messages of a simulated bag (read with `rosbags`,
 decoded and re-encoded by Cyclone's own CDR code from the hand-written types of
@@ -12,7 +12,9 @@ finite values, covariance shapes, position against the bag's truth within 3 sigm
 node's own covariance, and with --golden every solution equal to `gnss_ins replay`'s). With
 `--parameters` it also lists, reads, describes and sets the node's parameters through the
 standard parameter services (rmw_cyclonedds request/reply mapping; the node must run with
-RMW_IMPLEMENTATION=rmw_cyclonedds_cpp).
+RMW_IMPLEMENTATION=rmw_cyclonedds_cpp). With `--sim-time` it publishes the bag's time
+on /clock and checks that the node (run with use_sim_time) stamps its reports with it.
+The node's log lines must arrive on /rosout.
 
 Prints a JSON summary on stdout; every failed check on stderr, and exits 1 if any failed.
 Run it inside a loopback-only network namespace with the venv of
@@ -42,6 +44,9 @@ WGS84_A_M = 6378137.0
 WGS84_F = 1.0 / 298.257223563
 # Tolerance on symmetry and on the unit quaternion (rounding only).
 ROUNDING = 1e-9
+# The fixture's IMU rate, and every how many IMU samples the bag time goes on /clock.
+BAG_IMU_RATE_HZ = 100.0
+CLOCK_EVERY_IMU = 10
 # Wall time left between the last sample on one topic and the first on the other.
 TOPIC_SWITCH_GAP_S = 0.02
 # Odometry position error allowed, in multiples of the filter's own 3D sigma
@@ -155,7 +160,10 @@ class Peer:
                                 qos=qos)
         self.diagnostics = DataReader(self.participant,
                                       topic('/diagnostics', ros.DiagnosticArray), qos=qos)
-        self.received = {'odometry': [], 'fix': [], 'noise': [], 'diagnostics': []}
+        self.clock = DataWriter(self.participant, topic('/clock', ros.Clock), qos=qos)
+        self.rosout = DataReader(self.participant, topic('/rosout', ros.Log), qos=qos)
+        self.received = {'odometry': [], 'fix': [], 'noise': [], 'diagnostics': [],
+                         'rosout': []}
 
     def matched(self):
         return (self.imu.get_matched_subscriptions() and self.gnss.get_matched_subscriptions()
@@ -205,7 +213,7 @@ def handshake(peer, checks):
                        'the node never counted the NaN IMU sample and the empty GNSS epoch')
 
 
-def stream(peer, inputs, speed):
+def stream(peer, inputs, speed, clock_every):
     """Publishes the inputs paced at `speed` times real time; returns counts per topic.
 
     DDS orders the samples of one writer only: when the topic changes, the previous
@@ -225,6 +233,10 @@ def stream(peer, inputs, speed):
             time.sleep(wait)
         (peer.imu if topic == '/imu' else peer.gnss).write(message)
         sent[topic] += 1
+        # As `ros2 bag play --clock`: the bag's time on /clock (every `clock_every` IMU
+        # samples).
+        if clock_every and topic == '/imu' and sent[topic] % clock_every == 0:
+            peer.clock.write(ros.Clock(clock=message.header.stamp))
     return sent
 
 
@@ -341,6 +353,8 @@ def main():
     parser.add_argument('--variant', default='ekf')
     parser.add_argument('--golden', help='replay CSV of the same bag to compare the fixes with')
     parser.add_argument('--parameters', action='store_true')
+    parser.add_argument('--sim-time', action='store_true',
+                        help='publish the bag time on /clock; the node runs with use_sim_time')
     args = parser.parse_args()
 
     checks = Checks()
@@ -354,12 +368,12 @@ def main():
     if args.parameters:
         import parameter_client  # noqa: PLC0415  (only with --parameters)
         summary['parameters'] = parameter_client.exercise(peer.participant, args.namespace,
-                                                          args.node, checks)
+                                                          args.node, args.sim_time, checks)
     bad_imu = int(peer.latest_diagnostics().get('unconvertible_imu', 0))
-    for name in ('odometry', 'fix', 'noise'):
+    for name in ('odometry', 'fix', 'noise', 'diagnostics'):
         peer.received[name].clear()
     start = time.monotonic()
-    sent = stream(peer, inputs, args.speed)
+    sent = stream(peer, inputs, args.speed, CLOCK_EVERY_IMU if args.sim_time else 0)
     summary['stream_wall_s'] = time.monotonic() - start
     summary['sent'] = sent
     # Let the node finish and publish one more /diagnostics after the last input.
@@ -373,9 +387,50 @@ def main():
     node_fqn = f'{args.namespace.rstrip("/")}/{args.node}'
     summary['diagnostics'] = check_diagnostics(checks, received['diagnostics'], node_fqn, sent,
                                                bad_imu)
+    if args.sim_time:
+        summary['sim_time'] = check_sim_time(checks, received['diagnostics'], inputs)
+    summary['rosout'] = check_rosout(checks, received['rosout'], node_fqn, args.sim_time,
+                                     inputs, args.parameters)
     if args.golden:
         summary['golden'] = compare_golden(checks, received['fix'], args.golden)
     return report(summary, checks)
+
+
+def bag_span_s(inputs):
+    return inputs[0][0] * 1e-9, inputs[-1][0] * 1e-9
+
+
+def check_sim_time(checks, diagnostics, inputs):
+    """With use_sim_time the reports carry the bag's time from /clock and the IMU rate is
+    counted on it: the bag's 100 Hz, not the 4-times-faster wall rate."""
+    first_s, last_s = bag_span_s(inputs)
+    stamps = [seconds(d.header.stamp) for d in diagnostics]
+    checks.that(stamps and all(s <= last_s for s in stamps),
+                f'diagnostics stamps {stamps} beyond the bag ({last_s} s): not sim time')
+    checks.that(any(first_s < s for s in stamps), 'no diagnostics stamped with bag time')
+    rates = sorted(float(diagnostic_values(d)['imu_rate_hz']) for d in diagnostics
+                   if float(diagnostic_values(d).get('imu_rate_hz', 0.0)) > 0.0)
+    median = rates[len(rates) // 2] if rates else math.nan
+    checks.that(abs(median - BAG_IMU_RATE_HZ) <= 0.1 * BAG_IMU_RATE_HZ,
+                f'median imu_rate_hz {median} on sim time, bag rate {BAG_IMU_RATE_HZ}')
+    return {'diagnostics_stamps_s': stamps, 'imu_rate_hz_median': median}
+
+
+def check_rosout(checks, lines, node_fqn, sim_time, inputs, parameters):
+    """The node's log lines arrive on /rosout under its logger name."""
+    logger = node_fqn.strip('/').replace('/', '.')
+    own = [line for line in lines if line.name == logger]
+    checks.that(own, f'no /rosout line from {logger} (names: {sorted({x.name for x in lines})})')
+    started = [x for x in own if x.level == 20 and 'filter initialized' in x.msg]
+    checks.that(started, 'no /rosout INFO line "filter initialized"')
+    if sim_time and started:
+        first_s, last_s = bag_span_s(inputs)
+        t = seconds(started[0].stamp)
+        checks.that(first_s <= t <= last_s, f'/rosout stamp {t} s is not the bag time')
+    if parameters:
+        checks.that(any(x.level == 30 and 'read-only' in x.msg for x in own),
+                    'the refused parameter is not on /rosout as a warning')
+    return {'lines': len(own), 'levels': sorted({x.level for x in own})}
 
 
 def compare_golden(checks, fixes, golden_csv):

@@ -64,7 +64,7 @@ def double(value):
     return ros.ParameterValue(type=ros.ParameterType.DOUBLE, double_value=value)
 
 
-def exercise(participant, namespace, node, checks):
+def exercise(participant, namespace, node, sim_time, checks):
     """Runs the parameter checks; returns a summary (values seen, reply latencies)."""
     base = f'/{namespace.strip("/")}/{node}/'.replace('//', '/')
     P = ros
@@ -108,7 +108,7 @@ def exercise(participant, namespace, node, checks):
                     f'filter.variant = {v[0]}')
         checks.that(v[1].type == P.ParameterType.DOUBLE and v[1].double_value == 10.0,
                     f'gnss.elevation_mask_deg = {v[1]}')
-        checks.that(v[2].type == P.ParameterType.BOOL and v[2].bool_value is False,
+        checks.that(v[2].type == P.ParameterType.BOOL and v[2].bool_value is sim_time,
                     f'use_sim_time = {v[2]}')
         checks.that(v[3].type == P.ParameterType.NOT_SET, 'an unknown name is NOT_SET')
     types = call('types', P.GetParameterTypesRequest(names=asked))

@@ -14,7 +14,7 @@ fn main() -> ExitCode {
     // locators flood a host without multicast), ros2-client warnings, the rest at --log-level.
     let level = cli.log_level.as_deref().unwrap_or("info");
     let filter = format!("{level},rustdds=error,ros2_client=warn");
-    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or(filter)).init();
+    let log_lines = node::rosout::init_logging(&filter);
     let params = match node::params::load(&cli) {
         Ok(c) => c,
         Err(e) => return fail(&e),
@@ -28,7 +28,7 @@ fn main() -> ExitCode {
         domain_id,
         service_mapping: node::service_mapping_from(rmw.as_deref()),
     };
-    match node::run(&cli, params, dds) {
+    match node::run(&cli, params, dds, log_lines) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => fail(&e),
     }

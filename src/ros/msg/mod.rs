@@ -12,6 +12,7 @@ mod fixed_array;
 mod geometry;
 mod gnss;
 mod nav;
+mod rcl;
 mod rosgraph;
 mod sensor;
 mod tf2;
@@ -27,6 +28,7 @@ pub use gnss::{
     NOISE_ESTIMATES_MSG, SATELLITE_MEASUREMENT_MSG, SATELLITE_NOISE_MSG,
 };
 pub use nav::Odometry;
+pub use rcl::Log;
 pub use rosgraph::Clock;
 pub use sensor::{Imu, NavSatFix, NavSatStatus};
 pub use tf2::TFMessage;

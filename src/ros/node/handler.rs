@@ -251,7 +251,8 @@ impl NodeCore {
         msgs
     }
 
-    /// The /diagnostics report at `stamp`: input counts, rejections by reason, phase.
+    /// The /diagnostics report at `stamp`: input counts, rejections by reason, phase and,
+    /// once running, the filter's 3D position sigma (level ERROR when it is not finite).
     pub fn diagnostics(&self, node_name: &str, stamp: Time) -> DiagnosticArray {
         let phase = match self.engine.init_phase() {
             Some(p) => format!("initializing ({p:?})"),
@@ -281,20 +282,39 @@ impl NodeCore {
             key: format!("rejected_{}", reason.name()),
             value: n.to_string(),
         }));
-        let running = self.engine.init_phase().is_none();
+        let (level, message) = match self.engine.state() {
+            None => (DiagnosticStatus::WARN, phase),
+            Some(state) => {
+                // Filter health: the 3D position sigma the filter claims.
+                let sigma_m = state
+                    .solution()
+                    .position_covariance_enu_m2()
+                    .trace()
+                    .max(0.0)
+                    .sqrt();
+                values.push(KeyValue {
+                    key: "position_sigma_3d_m".to_owned(),
+                    value: format!("{sigma_m:.3}"),
+                });
+                if sigma_m.is_finite() {
+                    (DiagnosticStatus::OK, phase)
+                } else {
+                    (
+                        DiagnosticStatus::ERROR,
+                        "filter covariance is not finite".to_owned(),
+                    )
+                }
+            }
+        };
         DiagnosticArray {
             header: Header {
                 stamp,
                 frame_id: String::new(),
             },
             status: vec![DiagnosticStatus {
-                level: if running {
-                    DiagnosticStatus::OK
-                } else {
-                    DiagnosticStatus::WARN
-                },
+                level,
                 name: format!("{node_name}: filter"),
-                message: phase,
+                message,
                 hardware_id: String::new(),
                 values,
             }],

@@ -5,31 +5,39 @@
 //! publishes `odometry` (nav_msgs/Odometry, `map` → `base_link`), `fix` (NavSatFix),
 //! `~/noise_estimates` (NoiseEstimates) and `/diagnostics` (DiagnosticArray, 1 Hz).
 
+pub mod clock;
 pub mod handler;
+pub mod input_stats;
 pub mod log_limit;
 mod param_docs;
 pub mod param_server;
 pub mod params;
+pub mod rosout;
 pub mod services;
 
-use std::time::{Duration, SystemTime, UNIX_EPOCH};
+use std::time::Duration;
 
 use futures::stream::{self, LocalBoxStream, StreamExt};
 use ros2_client::{
-    qos::History, Context, ContextOptions, MessageInfo, MessageTypeName, Name, Node, NodeName,
-    NodeOptions, Publisher, QosProfile, ReadResult, ServiceMapping, Subscription,
+    qos::{Durability, History},
+    Context, ContextOptions, MessageInfo, MessageTypeName, Name, Node, NodeName, NodeOptions,
+    Publisher, QosProfile, ReadResult, ServiceMapping, Subscription,
 };
 
 use crate::ros::args::NodeArgs;
 use crate::ros::msg::{
-    DiagnosticArray, GnssMeasurements, Imu, NavSatFix, NoiseEstimates, Odometry, RosMessage, Time,
+    Clock, DiagnosticArray, GnssMeasurements, Imu, Log, NavSatFix, NoiseEstimates, Odometry,
+    RosMessage,
 };
 use crate::ros::names::resolve_remapped;
 
+use clock::NodeClock;
 pub use handler::{NodeCore, OutMsg};
+use input_stats::{InputStats, Stream};
 use log_limit::LogLimiter;
 use param_server::ParameterServer;
 use params::NodeParams;
+use rosout::{LogLine, LogLines};
 pub use services::service_mapping_from;
 use services::{ParamRequest, ParameterServices};
 
@@ -88,6 +96,14 @@ fn output_qos() -> QosProfile {
     QosProfile::publisher_default().history(History::KeepLast { depth: QUEUE_DEPTH })
 }
 
+/// `/rosout` QoS as rcl offers it: reliable, transient local, the last 1000 lines (so a
+/// late `rqt_console` sees the start-up lines, and volatile readers match too).
+fn rosout_qos() -> QosProfile {
+    QosProfile::publisher_default()
+        .durability(Durability::TransientLocal)
+        .history(History::KeepLast { depth: 1000 })
+}
+
 struct Names<'a> {
     args: &'a NodeArgs,
 }
@@ -119,32 +135,31 @@ fn publisher<M: RosMessage>(
     names: &Names,
     relative: &str,
 ) -> Result<Publisher<M>, NodeError> {
-    let name = names.topic(relative)?;
-    let topic = node
-        .create_topic(&name, type_name::<M>(), &output_qos())
-        .map_err(dds_error)?;
-    log::info!("publishing {name} ({})", M::TYPE_NAME);
-    node.create_publisher::<M>(&topic, Some(output_qos()))
-        .map_err(dds_error)
+    publisher_with::<M>(node, names, relative, output_qos())
 }
 
-/// Wall-clock ROS time for the diagnostics header (the filter's outputs carry the input
-/// stamps instead).
-fn wall_time() -> Time {
-    let d = SystemTime::now()
-        .duration_since(UNIX_EPOCH)
-        .unwrap_or_default();
-    Time {
-        sec: i32::try_from(d.as_secs()).unwrap_or(i32::MAX),
-        nanosec: d.subsec_nanos(),
-    }
+fn publisher_with<M: RosMessage>(
+    node: &mut Node,
+    names: &Names,
+    relative: &str,
+    qos: QosProfile,
+) -> Result<Publisher<M>, NodeError> {
+    let name = names.topic(relative)?;
+    let topic = node
+        .create_topic(&name, type_name::<M>(), &qos)
+        .map_err(dds_error)?;
+    log::info!("publishing {name} ({})", M::TYPE_NAME);
+    node.create_publisher::<M>(&topic, Some(qos))
+        .map_err(dds_error)
 }
 
 enum Event {
     Imu(Result<Imu, String>),
     Gnss(Result<GnssMeasurements, String>),
     Fix(Result<NavSatFix, String>),
+    Clock(Result<Clock, String>),
     Param(ParamRequest),
+    LogLine(LogLine),
     Tick,
 }
 
@@ -179,12 +194,20 @@ impl Outputs {
     }
 }
 
-/// Runs the node until the process is stopped (or the DDS streams end).
-pub fn run(args: &NodeArgs, params: NodeParams, dds: DdsOptions) -> Result<(), NodeError> {
+/// Runs the node until the process is stopped (or the DDS streams end). `log_lines`
+/// (from [`rosout::init_logging`]) are published on `/rosout`.
+pub fn run(
+    args: &NodeArgs,
+    params: NodeParams,
+    dds: DdsOptions,
+    log_lines: Option<LogLines>,
+) -> Result<(), NodeError> {
     let domain_id = dds.domain_id;
     let context =
         Context::with_options(ContextOptions::new().domain_id(domain_id)).map_err(dds_error)?;
     let node_name = NodeName::new(&args.namespace, &args.node_name).map_err(dds_error)?;
+    // ros2-client's own rosout, parameter services and sim time stay off: the node
+    // serves its configuration itself and its /clock has the wrong type.
     let mut node = context
         .new_node(
             node_name,
@@ -197,6 +220,7 @@ pub fn run(args: &NodeArgs, params: NodeParams, dds: DdsOptions) -> Result<(), N
     let imu_sub = subscription::<Imu>(&mut node, &names, "imu")?;
     let gnss_sub = subscription::<GnssMeasurements>(&mut node, &names, "gnss/measurements")?;
     let fix_sub = subscription::<NavSatFix>(&mut node, &names, "gnss/fix")?;
+    let clock_sub = subscription::<Clock>(&mut node, &names, "/clock")?;
     let mut outputs = Outputs {
         odometry: publisher(&mut node, &names, "odometry")?,
         fix: publisher(&mut node, &names, "fix")?,
@@ -204,15 +228,15 @@ pub fn run(args: &NodeArgs, params: NodeParams, dds: DdsOptions) -> Result<(), N
         log: LogLimiter::default(),
     };
     let diagnostics = publisher::<DiagnosticArray>(&mut node, &names, "/diagnostics")?;
+    let rosout = publisher_with::<Log>(&mut node, &names, "/rosout", rosout_qos())?;
     let services = ParameterServices::new(&mut node, dds.service_mapping)?;
     let config = params.config;
-    log::info!(
-        "{} running filter variant {} on DDS domain {domain_id}",
-        node.fully_qualified_name(),
-        config.filter.variant.as_str()
-    );
+    let fqn = node.fully_qualified_name();
+    let logger = rosout::logger_name(&fqn);
     let mut core = NodeCore::new(config);
     let mut parameters = ParameterServer::new(params.use_sim_time);
+    let mut clock = NodeClock::default();
+    let mut stats = InputStats::default();
 
     let mut sources: Vec<LocalBoxStream<'_, Event>> = vec![
         imu_sub
@@ -227,6 +251,10 @@ pub fn run(args: &NodeArgs, params: NodeParams, dds: DdsOptions) -> Result<(), N
             .async_stream()
             .map(|r| Event::Fix(decoded(r)))
             .boxed_local(),
+        clock_sub
+            .async_stream()
+            .map(|r| Event::Clock(decoded(r)))
+            .boxed_local(),
         smol::Timer::interval(DIAGNOSTICS_PERIOD)
             .map(|_| Event::Tick)
             .boxed_local(),
@@ -237,24 +265,67 @@ pub fn run(args: &NodeArgs, params: NodeParams, dds: DdsOptions) -> Result<(), N
             .into_iter()
             .map(|s| s.map(Event::Param).boxed_local()),
     );
+    if let Some(lines) = log_lines {
+        sources.push(lines.map(Event::LogLine).boxed_local());
+    }
     let mut events = stream::select_all(sources);
-    let fqn = node.fully_qualified_name();
+    log::info!(
+        "{fqn} running filter variant {} on DDS domain {domain_id}{}",
+        core.engine().variant_name(),
+        if parameters.use_sim_time() {
+            " (use_sim_time: node time follows /clock)"
+        } else {
+            ""
+        }
+    );
 
     smol::block_on(async {
         while let Some(event) = events.next().await {
+            let now_s = || clock.now_s(parameters.use_sim_time());
             let msgs = match event {
-                Event::Imu(Ok(m)) => core.on_imu(&m),
-                Event::Gnss(Ok(m)) => core.on_gnss(&m),
-                Event::Fix(Ok(m)) => core.on_fix(&m),
-                Event::Imu(Err(e)) => undecodable(&mut core, "imu", &e),
-                Event::Gnss(Err(e)) => undecodable(&mut core, "gnss/measurements", &e),
-                Event::Fix(Err(e)) => undecodable(&mut core, "gnss/fix", &e),
+                Event::Imu(m) => {
+                    stats.record(Stream::Imu, now_s());
+                    match m {
+                        Ok(m) => core.on_imu(&m),
+                        Err(e) => undecodable(&mut core, "imu", &e),
+                    }
+                }
+                Event::Gnss(m) => {
+                    stats.record(Stream::Gnss, now_s());
+                    match m {
+                        Ok(m) => core.on_gnss(&m),
+                        Err(e) => undecodable(&mut core, "gnss/measurements", &e),
+                    }
+                }
+                Event::Fix(m) => {
+                    stats.record(Stream::Fix, now_s());
+                    match m {
+                        Ok(m) => core.on_fix(&m),
+                        Err(e) => undecodable(&mut core, "gnss/fix", &e),
+                    }
+                }
+                Event::Clock(Ok(m)) => {
+                    clock.on_clock(&m);
+                    Vec::new()
+                }
+                Event::Clock(Err(e)) => undecodable(&mut core, "/clock", &e),
                 Event::Param(request) => {
                     services.answer(request, &mut parameters, &mut core);
                     Vec::new()
                 }
+                Event::LogLine(line) => {
+                    let stamp = clock.now(parameters.use_sim_time());
+                    let message = rosout::rosout_message(line, &logger, stamp);
+                    // Not logged again: a failure here would feed itself.
+                    let _ = rosout.publish(message);
+                    Vec::new()
+                }
                 Event::Tick => {
-                    let report = core.diagnostics(&fqn, wall_time());
+                    let stamp = clock.now(parameters.use_sim_time());
+                    let mut report = core.diagnostics(&fqn, stamp);
+                    if let Some(status) = report.status.first_mut() {
+                        stats.report(status, now_s());
+                    }
                     if let Err(e) = diagnostics.publish(report) {
                         log::warn!("publishing diagnostics failed: {e:?}");
                     }
