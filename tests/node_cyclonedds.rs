@@ -14,10 +14,11 @@ mod netns_support;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
+use serde_json::Value;
+
 use netns_support::{reexec_in_private_netns, KillOnDrop};
 
 const DOMAIN_ID: &str = "23";
-const NAMESPACE: &str = "/interop";
 const NODE: &str = "ins";
 /// Playback speed of the 36 s fixture (about 9 s of wall time).
 const SPEED_UP: &str = "4";
@@ -57,9 +58,9 @@ fn fixture_datum() -> String {
     )
 }
 
-fn start_node(extra_args: &[&str]) -> KillOnDrop {
+fn start_node(namespace: &str, extra_args: &[&str]) -> KillOnDrop {
     let node = Command::new(env!("CARGO_BIN_EXE_gnss_ins_node"))
-        .args(["--ros-args", "-r", &format!("__ns:={NAMESPACE}")])
+        .args(["--ros-args", "-r", &format!("__ns:={namespace}")])
         .args(["-r", &format!("__node:={NODE}")])
         .args(["-p", &fixture_datum()])
         .args(extra_args)
@@ -72,17 +73,16 @@ fn start_node(extra_args: &[&str]) -> KillOnDrop {
     KillOnDrop(node)
 }
 
-fn run_peer(python: &Path, extra_args: &[&str]) {
-    let data = manifest_dir().join("tests/data");
+/// Runs `tools/<script>` against the node in `namespace`; returns its JSON summary after
+/// asserting that none of its checks failed.
+fn run_peer(python: &Path, script: &str, namespace: &str, extra_args: &[&str]) -> Value {
     let out = Command::new(python)
-        .arg(manifest_dir().join("tools/cyclonedds_peer.py"))
+        .arg(manifest_dir().join("tools").join(script))
         .arg("--bag")
-        .arg(data.join("fixture_small.mcap"))
-        .arg("--golden")
-        .arg(data.join("fixture_small_solution.csv"))
+        .arg(manifest_dir().join("tests/data/fixture_small.mcap"))
         .args([
             "--namespace",
-            NAMESPACE,
+            namespace,
             "--node",
             NODE,
             "--speed",
@@ -92,32 +92,54 @@ fn run_peer(python: &Path, extra_args: &[&str]) {
         .env("ROS_DOMAIN_ID", DOMAIN_ID)
         .stdin(Stdio::null())
         .output()
-        .expect("run tools/cyclonedds_peer.py");
+        .expect("run the Cyclone DDS peer");
     let stdout = String::from_utf8_lossy(&out.stdout);
     let stderr = String::from_utf8_lossy(&out.stderr);
-    eprintln!("cyclonedds_peer.py summary:\n{stdout}\n{stderr}");
+    eprintln!("{script} summary:\n{stdout}\n{stderr}");
     assert!(
         out.status.success(),
         "the Cyclone DDS peer found problems:\n{stderr}"
     );
-    let summary: serde_json::Value = serde_json::from_str(&stdout).expect("JSON summary");
-    // The peer's own checks passed; make sure it did check something.
-    assert!(summary["odometry"]["count"].as_u64().unwrap_or(0) > 2000);
-    assert!(summary["golden"]["matched"].as_u64().unwrap_or(0) > 2000);
-    if extra_args.contains(&"--parameters") {
-        assert!(summary["parameters"]["listed"].as_u64().unwrap_or(0) > 50);
-    }
+    serde_json::from_str(&stdout).expect("JSON summary")
 }
 
 /// The peer first lists, reads, describes and sets parameters through the node's
 /// parameter services (leaving them as they were), then plays the bag with its time on
-/// /clock (the node runs with use_sim_time) and checks /rosout too.
+/// /clock (the node runs with use_sim_time) and checks every output, /rosout too, and
+/// that every solution equals `gnss_ins replay`'s (tests/data/fixture_small_solution.csv).
 #[test]
 fn cyclonedds_peer_sets_parameters_and_plays_a_bag_into_the_node() {
     let python = venv_python();
     if reexec_in_private_netns("cyclonedds_peer_sets_parameters_and_plays_a_bag_into_the_node") {
         return;
     }
-    let _node = start_node(&["-p", "use_sim_time:=true"]);
-    run_peer(&python, &["--parameters", "--sim-time"]);
+    let _node = start_node("/interop", &["-p", "use_sim_time:=true"]);
+    let golden = manifest_dir().join("tests/data/fixture_small_solution.csv");
+    let golden = golden.to_str().expect("UTF-8 path");
+    let summary = run_peer(
+        &python,
+        "cyclonedds_peer.py",
+        "/interop",
+        &["--parameters", "--sim-time", "--golden", golden],
+    );
+    // The peer's own checks passed; make sure it did check something.
+    assert!(summary["odometry"]["count"].as_u64().unwrap_or(0) > 2000);
+    assert!(summary["golden"]["matched"].as_u64().unwrap_or(0) > 2000);
+    assert!(summary["parameters"]["listed"].as_u64().unwrap_or(0) > 50);
+}
+
+/// Undecodable payloads, wrong array sizes, NaN, repeated and backward stamps, GNSS before
+/// any IMU and a second IMU publisher with another frame: all counted in /diagnostics,
+/// the node keeps running and publishes no NaN (tools/cyclonedds_bad_inputs.py).
+#[test]
+fn cyclonedds_peer_bad_inputs_are_counted_and_the_node_carries_on() {
+    let python = venv_python();
+    if reexec_in_private_netns("cyclonedds_peer_bad_inputs_are_counted_and_the_node_carries_on") {
+        return;
+    }
+    let _node = start_node("/bad", &[]);
+    let summary = run_peer(&python, "cyclonedds_bad_inputs.py", "/bad", &[]);
+    assert!(summary["odometry"].as_u64().unwrap_or(0) > 2000);
+    let sent = &summary["bad_samples_sent"];
+    assert!(sent["foreign_frame"].as_u64().unwrap_or(0) > 5, "{sent}");
 }

@@ -75,6 +75,35 @@ pub struct InputCounts {
     pub time_jump_resets: u64,
     /// Outputs not published because a value was not finite.
     pub non_finite_outputs: u64,
+    /// IMU messages from another frame than the first accepted one (a second publisher).
+    pub foreign_frame_imu: u64,
+    /// GnssMeasurements messages from another frame than the first accepted one.
+    pub foreign_frame_gnss: u64,
+    /// NavSatFix messages from another frame than the first accepted one.
+    pub foreign_frame_fix: u64,
+}
+
+/// The `header.frame_id` a stream is locked to.
+///
+/// Choice: the first message the engine accepts fixes the frame of its stream; messages
+/// from any other frame are counted and dropped. Two sensors interleaved on one topic would
+/// otherwise be fused as one (duplicate and backward stamps, mixed lever arms and
+/// mounting), and the node has one IMU and one antenna. The lock survives filter resets.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+struct FrameLock(Option<String>);
+
+impl FrameLock {
+    /// True when no frame is locked yet or `frame_id` is the locked one.
+    fn admits(&self, frame_id: &str) -> bool {
+        self.0.as_deref().is_none_or(|locked| locked == frame_id)
+    }
+
+    /// Locks `frame_id` when no frame is locked yet.
+    fn accepted(&mut self, frame_id: &str) {
+        if self.0.is_none() {
+            self.0 = Some(frame_id.to_owned());
+        }
+    }
 }
 
 /// Engine plus message conversion for one node.
@@ -83,6 +112,9 @@ pub struct NodeCore {
     datum: Option<Llh>,
     counts: InputCounts,
     log: LogLimiter,
+    imu_frame: FrameLock,
+    gnss_frame: FrameLock,
+    fix_frame: FrameLock,
 }
 
 impl NodeCore {
@@ -94,6 +126,9 @@ impl NodeCore {
             datum,
             counts: InputCounts::default(),
             log: LogLimiter::default(),
+            imu_frame: FrameLock::default(),
+            gnss_frame: FrameLock::default(),
+            fix_frame: FrameLock::default(),
         }
     }
 
@@ -129,6 +164,9 @@ impl NodeCore {
             Ok(s) => s,
             Err(e) => return self.unconvertible(Input::Imu, &e.to_string()),
         };
+        if !self.imu_frame.admits(&msg.header.frame_id) {
+            return self.foreign_frame(Input::Imu, &msg.header.frame_id);
+        }
         let mut outputs = Vec::new();
         if let Some(last_t_s) = self.engine.last_imu_t_s() {
             if sample.t_s < last_t_s - TIME_JUMP_BACK_S {
@@ -144,7 +182,10 @@ impl NodeCore {
             }
         }
         match self.engine.push_imu(&sample) {
-            Ok(o) => outputs.extend(o),
+            Ok(o) => {
+                self.imu_frame.accepted(&msg.header.frame_id);
+                outputs.extend(o);
+            }
             Err(e) => {
                 self.log.warn(e.reason.name(), &format!("imu: {e}"));
             }
@@ -159,8 +200,14 @@ impl NodeCore {
             Ok(e) => e,
             Err(e) => return self.unconvertible(Input::Gnss, &e.to_string()),
         };
+        if !self.gnss_frame.admits(&msg.header.frame_id) {
+            return self.foreign_frame(Input::Gnss, &msg.header.frame_id);
+        }
         let outputs = match self.engine.push_gnss(epoch) {
-            Ok(o) => o,
+            Ok(o) => {
+                self.gnss_frame.accepted(&msg.header.frame_id);
+                o
+            }
             Err(e) => {
                 self.log.warn(e.reason.name(), &format!("gnss: {e}"));
                 Vec::new()
@@ -176,9 +223,15 @@ impl NodeCore {
             Ok(t) if msg.status.status >= 0 => t,
             _ => return self.unconvertible(Input::Fix, "no solution or invalid stamp"),
         };
+        if !self.fix_frame.admits(&msg.header.frame_id) {
+            return self.foreign_frame(Input::Fix, &msg.header.frame_id);
+        }
         let fix = fix_of(msg, t_s);
         let outputs = match self.engine.push_fix(fix) {
-            Ok(o) => o,
+            Ok(o) => {
+                self.fix_frame.accepted(&msg.header.frame_id);
+                o
+            }
             Err(e) => {
                 self.log.warn(e.reason.name(), &format!("fix: {e}"));
                 Vec::new()
@@ -198,6 +251,22 @@ impl NodeCore {
         self.log.warn(
             &format!("unconvertible {name}"),
             &format!("dropped a message on {name}: {error}"),
+        );
+        Vec::new()
+    }
+
+    fn foreign_frame(&mut self, input: Input, frame_id: &str) -> Vec<OutMsg> {
+        let (counter, lock) = match input {
+            Input::Imu => (&mut self.counts.foreign_frame_imu, &self.imu_frame),
+            Input::Gnss => (&mut self.counts.foreign_frame_gnss, &self.gnss_frame),
+            Input::Fix => (&mut self.counts.foreign_frame_fix, &self.fix_frame),
+        };
+        *counter += 1;
+        let locked = lock.0.clone().unwrap_or_default();
+        let name = input.name();
+        self.log.warn(
+            &format!("foreign frame {name}"),
+            &format!("dropped a message on {name} from frame `{frame_id}`: the node follows `{locked}` (a second publisher?)"),
         );
         Vec::new()
     }
@@ -271,6 +340,9 @@ impl NodeCore {
             ("unconvertible_fix", c.unconvertible_fix.to_string()),
             ("time_jump_resets", c.time_jump_resets.to_string()),
             ("non_finite_outputs", c.non_finite_outputs.to_string()),
+            ("foreign_frame_imu", c.foreign_frame_imu.to_string()),
+            ("foreign_frame_gnss", c.foreign_frame_gnss.to_string()),
+            ("foreign_frame_fix", c.foreign_frame_fix.to_string()),
         ]
         .into_iter()
         .map(|(key, value)| KeyValue {
@@ -434,6 +506,28 @@ mod tests {
         // The node goes on with good data.
         feed(&mut core, 10.7, 11.0);
         assert_eq!(core.engine().last_imu_t_s(), Some(10.99));
+    }
+
+    #[test]
+    fn a_second_imu_frame_is_counted_and_dropped() {
+        let mut core = NodeCore::new(Config::default());
+        feed(&mut core, 10.0, 10.5);
+        let mut other = imu_at(10.505);
+        other.header.frame_id = "other_imu".to_owned();
+        assert!(core.on_imu(&other).is_empty());
+        assert_eq!(core.counts().foreign_frame_imu, 1);
+        assert_eq!(
+            core.engine().last_imu_t_s(),
+            Some(10.49),
+            "not fed to the engine"
+        );
+        assert_eq!(diagnostic(&core, "foreign_frame_imu").as_deref(), Some("1"));
+        feed(&mut core, 10.5, 10.6);
+        assert_eq!(
+            core.engine().last_imu_t_s(),
+            Some(10.59),
+            "the first frame goes on"
+        );
     }
 
     #[test]
