@@ -1,9 +1,11 @@
 //! The `gnss_ins_node` ROS 2 node: DDS subscriptions and publishers around [`NodeCore`].
 //!
 //! Topics (relative, so `__ns` and remappings apply): subscribes `imu`
-//! (sensor_msgs/Imu), `gnss/measurements` (GnssMeasurements), `gnss/fix` (NavSatFix);
-//! publishes `odometry` (nav_msgs/Odometry, `map` → `base_link`), `fix` (NavSatFix),
-//! `~/noise_estimates` (NoiseEstimates) and `/diagnostics` (DiagnosticArray, 1 Hz).
+//! (sensor_msgs/Imu), `gnss/measurements` (GnssMeasurements), `gnss/fix` (NavSatFix),
+//! `/clock` (rosgraph_msgs/Clock, for `use_sim_time`); publishes `odometry`
+//! (nav_msgs/Odometry, `map` → `base_link`), `fix` (NavSatFix), `~/noise_estimates`
+//! (NoiseEstimates), `/diagnostics` (DiagnosticArray, 1 Hz) and `/rosout`
+//! (rcl_interfaces/Log). Serves the parameter services ([`services`]).
 
 pub mod clock;
 pub mod handler;
