@@ -2,11 +2,13 @@
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use clap::{Subcommand, ValueEnum};
 
 use crate::config::{Config, FilterVariant};
+use crate::ros::node::domain_id_from;
+use crate::ros::player::{self, PlayOptions};
 use crate::sim::{Scenario, ScenarioSpec};
 
 use super::compare::{format_csv, format_table, ComparisonRow};
@@ -71,6 +73,29 @@ pub enum Command {
     Demo {
         #[arg(long, default_value_t = 1)]
         seed: u64,
+    },
+    /// Publish a bag onto DDS (domain `ROS_DOMAIN_ID`) with its recorded topic names and
+    /// types, paced by its log times, like `ros2 bag play`.
+    Play {
+        bag: PathBuf,
+        /// Speed factor (2 plays twice as fast as recorded).
+        #[arg(long, default_value_t = 1.0)]
+        rate: f64,
+        /// Publish /clock (rosgraph_msgs/Clock) with the bag's time, for use_sim_time.
+        #[arg(long)]
+        clock: bool,
+        /// Rate of /clock in bag time (Hz).
+        #[arg(long, default_value_t = 40.0)]
+        clock_hz: f64,
+        /// Play again from the start when the bag ends, until stopped.
+        #[arg(long = "loop")]
+        repeat: bool,
+        /// Seconds to wait after creating the publishers, before the first message.
+        #[arg(long, default_value_t = 0.0)]
+        delay: f64,
+        /// A topic that must have a matched subscriber before playing starts (repeatable).
+        #[arg(long = "wait-for")]
+        wait_for: Vec<String>,
     },
 }
 
@@ -193,6 +218,38 @@ pub fn run(command: Command) -> Result<(), String> {
                     .collect();
                 let files = write_plots(&dir, &runs).map_err(|e| e.to_string())?;
                 eprintln!("wrote {} figures into {}", files.len(), dir.display());
+            }
+            Ok(())
+        }
+        Command::Play {
+            bag,
+            rate,
+            clock,
+            clock_hz,
+            repeat,
+            delay,
+            wait_for,
+        } => {
+            let domain_id = domain_id_from(std::env::var("ROS_DOMAIN_ID").ok().as_deref())
+                .map_err(|e| e.to_string())?;
+            let delay = Duration::try_from_secs_f64(delay).map_err(|_| {
+                format!("--delay must be a non-negative number of seconds, got {delay}")
+            })?;
+            let options = PlayOptions {
+                rate,
+                clock,
+                clock_hz,
+                repeat,
+                delay,
+                wait_for_topics: wait_for,
+                domain_id,
+            };
+            let report = player::play(&bag, &options).map_err(|e| e.to_string())?;
+            for (topic, n) in &report.published {
+                println!("{topic}: {n} published");
+            }
+            for (reason, n) in &report.skipped {
+                println!("skipped ({reason}): {n}");
             }
             Ok(())
         }
