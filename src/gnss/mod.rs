@@ -3,6 +3,7 @@
 
 pub mod atmosphere;
 pub mod ephemeris;
+pub mod epoch_build;
 pub mod geometry;
 mod observation;
 pub mod rinex_nav;
