@@ -7,6 +7,8 @@ use std::time::Instant;
 use clap::{Subcommand, ValueEnum};
 
 use crate::config::{Config, FilterVariant};
+use crate::gnss::atmosphere::TroposphereModel;
+use crate::gnss::rinex_spp::{Ionosphere, RinexSppOptions};
 use crate::sim::{Scenario, ScenarioSpec};
 
 use super::compare::{format_csv, format_table, ComparisonRow};
@@ -14,6 +16,7 @@ use super::plots::{write_plots, FilterRun};
 use super::replay::{self, ReplayOptions, TruthSource};
 use super::session::{Session, SessionReport};
 use super::simulate::{self, TRUTH_TOPIC};
+use super::spp_rinex::spp_rinex;
 
 /// Scoring interval of the comparisons (s): every reference sample of a simulated bag
 /// (10 Hz).
@@ -71,6 +74,20 @@ pub enum Command {
     Demo {
         #[arg(long, default_value_t = 1)]
         seed: u64,
+    },
+    /// Single-point positions of every epoch of a RINEX 3 observation file with RTKLIB
+    /// rnx2rtkp's single-point settings (GPS L1 C/A, 10° mask, Klobuchar, Saastamoinen).
+    SppRinex {
+        /// RINEX 3 observation file.
+        obs: PathBuf,
+        /// RINEX 3 navigation file.
+        nav: PathBuf,
+        /// Output CSV, one line per epoch.
+        #[arg(long)]
+        out_csv: PathBuf,
+        /// Neither ionospheric nor tropospheric delays (rnx2rtkp's command-line default).
+        #[arg(long)]
+        no_atmosphere: bool,
     },
 }
 
@@ -194,6 +211,29 @@ pub fn run(command: Command) -> Result<(), String> {
                 let files = write_plots(&dir, &runs).map_err(|e| e.to_string())?;
                 eprintln!("wrote {} figures into {}", files.len(), dir.display());
             }
+            Ok(())
+        }
+        Command::SppRinex {
+            obs,
+            nav,
+            out_csv,
+            no_atmosphere,
+        } => {
+            let options = if no_atmosphere {
+                RinexSppOptions::rtklib_single(Ionosphere::Off, TroposphereModel::Off)
+            } else {
+                RinexSppOptions::rtklib_single_brdc_saas()
+            };
+            let s = spp_rinex(&obs, &nav, &out_csv, &options).map_err(|e| e.to_string())?;
+            eprintln!(
+                "wrote {}: {} of {} epochs solved ({} malformed lines, {} event records \
+                 skipped)",
+                out_csv.display(),
+                s.solved,
+                s.epochs,
+                s.malformed_lines,
+                s.skipped_records
+            );
             Ok(())
         }
         Command::Demo { seed } => {

@@ -9,3 +9,4 @@ pub mod replay;
 pub mod scenario_inputs;
 pub mod session;
 pub mod simulate;
+pub mod spp_rinex;
