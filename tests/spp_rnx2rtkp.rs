@@ -15,6 +15,7 @@ use adaptive_gnss_ins::gnss::rinex_spp::{
     solve_rinex_spp, Ionosphere, RinexSppEpoch, RinexSppOptions,
 };
 use adaptive_gnss_ins::gnss::spp::SppError;
+use adaptive_gnss_ins::tools::spp_rinex::spp_rinex;
 use nalgebra::Vector3;
 
 /// The budget: epoch-by-epoch agreement within 0.5 m RMS.
@@ -192,4 +193,41 @@ fn spp_matches_rnx2rtkp_without_atmosphere() {
     assert_eq!(a.matched, 528);
     assert!(a.rms_3d_m < MAX_RMS_M, "3D RMS {} m", a.rms_3d_m);
     assert!(a.max_3d_m < MAX_EPOCH_DIFFERENCE_M, "max {} m", a.max_3d_m);
+}
+
+#[test]
+fn spp_rinex_tool_writes_one_line_per_epoch() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/walk_0827");
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("spp.csv");
+    let options = RinexSppOptions::rtklib_single_brdc_saas();
+    let summary = spp_rinex(
+        &root.join("walk_1730.obs"),
+        &root.join("walk_1730.nav"),
+        &csv,
+        &options,
+    )
+    .unwrap();
+    assert_eq!((summary.epochs, summary.solved), (536, 528));
+    assert_eq!((summary.malformed_lines, summary.skipped_records), (0, 0));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 537);
+    assert!(lines[0].starts_with("gps_week,gps_tow_s,status,num_used,x_m"));
+    // The first line's position is the library's solution, to the 0.1 mm written.
+    let solved = ours(&options);
+    let first = solved[0].solution.as_ref().unwrap();
+    let f: Vec<&str> = lines[1].split(',').collect();
+    assert_eq!((f[0], f[2], f[3]), ("2381", "solved", "4"));
+    let x: Vec<f64> = f[4..7].iter().map(|v| v.parse().unwrap()).collect();
+    assert!((Vector3::new(x[0], x[1], x[2]) - first.pos_ecef_m).norm() < 1e-4);
+    let unsolved = lines
+        .iter()
+        .filter(|l| l.contains(",not_enough_satellites,"))
+        .count();
+    assert_eq!(unsolved, 8);
+    // A missing file is an error naming it.
+    let missing = root.join("no_such.obs");
+    let err = spp_rinex(&missing, &root.join("walk_1730.nav"), &csv, &options).unwrap_err();
+    assert!(err.to_string().contains("no_such.obs"), "{err}");
 }

@@ -21,16 +21,19 @@ use crate::gnss::spp::SppError;
 /// Why the tool could not run.
 #[derive(Debug, Error)]
 pub enum SppRinexError {
+    /// A file could not be read or written.
     #[error("{path}: {source}")]
     Io {
         path: PathBuf,
         source: std::io::Error,
     },
+    /// The observation file's header is unreadable.
     #[error("{path}: {source}")]
     Observation {
         path: PathBuf,
         source: RinexObsError,
     },
+    /// The navigation file is unreadable.
     #[error("{path}: {source}")]
     Navigation {
         path: PathBuf,

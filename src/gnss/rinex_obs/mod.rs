@@ -31,6 +31,7 @@ pub use record::{
 /// Contents of a RINEX 3 observation file.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RinexObs {
+    /// The header.
     pub header: ObsHeader,
     /// Observation epochs (flags 0 and 1), in file order.
     pub epochs: Vec<ObsEpoch>,

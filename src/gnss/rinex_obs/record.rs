@@ -43,13 +43,16 @@ pub struct ObsValue {
 /// One observation code and its value.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Observation {
+    /// Observation code (`C1C`, `L1C`, ...).
     pub code: ObsCode,
+    /// Its value and indicators.
     pub value: ObsValue,
 }
 
 /// The observations of one satellite at one epoch.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SatRecord {
+    /// The satellite.
     pub sat: SatId,
     /// The values present, in the header's order of types.
     pub observations: Vec<Observation>,
