@@ -10,7 +10,7 @@ use crate::config::{Config, FilterVariant};
 use crate::sim::{Scenario, ScenarioSpec};
 
 use super::cli_play::{self, PlayArgs};
-use super::cli_real::{self, ConvertArgs, SppArgs};
+use super::cli_real::{self, ConvertArgs, SppArgs, SppRinexArgs};
 use super::compare::{
     format_csv, format_environment_table, format_table, ComparisonRow, EnvironmentRow,
 };
@@ -92,6 +92,9 @@ pub enum Command {
     /// Publish a bag onto DDS (domain `ROS_DOMAIN_ID`) with its recorded topic names and
     /// types, paced by its log times, like `ros2 bag play`.
     Play(PlayArgs),
+    /// Single-point positions of every epoch of a RINEX 3 observation file with RTKLIB
+    /// rnx2rtkp's single-point settings (GPS L1 C/A, 10° mask, Klobuchar, Saastamoinen).
+    SppRinex(SppRinexArgs),
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -238,6 +241,7 @@ pub fn run(command: Command) -> Result<(), String> {
         Command::Play(args) => cli_play::play(args),
         Command::Convert(args) => cli_real::convert(args),
         Command::Spp(args) => cli_real::spp(args),
+        Command::SppRinex(args) => cli_real::spp_rinex(args),
         Command::Demo { seed } => {
             let dir = std::env::temp_dir().join(format!("gnss_ins_demo_{}", std::process::id()));
             std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;

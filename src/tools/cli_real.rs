@@ -13,8 +13,11 @@ use super::convert::{
 use super::imu_csv::{AccelUnit, GyroUnit, ImuCsvFormat};
 use super::replay::bag_inputs;
 use super::simulate::TRUTH_TOPIC;
+use super::spp_rinex::spp_rinex as solve_rinex_files;
 use super::spp_run::{run_spp, write_spp_csv};
 use super::time_scale::DEFAULT_GPS_UTC_LEAP_S;
+use crate::gnss::atmosphere::TroposphereModel;
+use crate::gnss::rinex_spp::{Ionosphere, RinexSppOptions};
 
 /// Unit of the accelerometer columns.
 #[derive(Clone, Copy, ValueEnum)]
@@ -271,5 +274,39 @@ pub fn spp(args: SppArgs) -> Result<(), String> {
             label, s.epochs, s.pos_rmse_horizontal_m, s.pos_rmse_u_m, s.pos_rmse_3d_m
         );
     }
+    Ok(())
+}
+
+/// `gnss_ins spp-rinex`: RINEX 3 observation and navigation files.
+#[derive(Args)]
+pub struct SppRinexArgs {
+    /// RINEX 3 observation file.
+    obs: PathBuf,
+    /// RINEX 3 navigation file.
+    nav: PathBuf,
+    /// Output CSV, one line per epoch.
+    #[arg(long)]
+    out_csv: PathBuf,
+    /// Neither ionospheric nor tropospheric delays (rnx2rtkp's command-line default).
+    #[arg(long)]
+    no_atmosphere: bool,
+}
+
+pub fn spp_rinex(args: SppRinexArgs) -> Result<(), String> {
+    let options = if args.no_atmosphere {
+        RinexSppOptions::rtklib_single(Ionosphere::Off, TroposphereModel::Off)
+    } else {
+        RinexSppOptions::rtklib_single_brdc_saas()
+    };
+    let s = solve_rinex_files(&args.obs, &args.nav, &args.out_csv, &options)
+        .map_err(|e| e.to_string())?;
+    eprintln!(
+        "wrote {}: {} of {} epochs solved ({} malformed lines, {} event records skipped)",
+        args.out_csv.display(),
+        s.solved,
+        s.epochs,
+        s.malformed_lines,
+        s.skipped_records
+    );
     Ok(())
 }

@@ -14,6 +14,7 @@ pub mod rtklib_pos;
 pub mod scenario_inputs;
 pub mod session;
 pub mod simulate;
+pub mod spp_rinex;
 pub mod spp_run;
 pub mod time_scale;
 pub mod time_tag;
