@@ -301,10 +301,25 @@ fn print_rates(label: &str, coeffs: &[f64], max_order: usize, rates: (f64, f64, 
 }
 
 /// The issue's target with the paper's criterion. It fails for a real reason: AIC is not a
-/// consistent order estimator and over-fits in roughly 16–30 % of draws however long the
-/// sequence (Shibata 1976). Measured with these seeds: AR(2) 66.5 %, AR(3) 69.0 % exact at
-/// max_order 5, never under-fitted. Run with `--ignored` to see it; BIC meets the target
-/// (next test).
+/// consistent order estimator. Shibata (1976): with L orders above the true one, its
+/// probability of the exact order tends to P(every partial sum of L terms 2 − χ²₁ is
+/// positive): 84.3 % for L = 1, 76.0 % for L = 3 (AR(2), max_order 5), 78.7 % for L = 2
+/// (AR(3)), 72.9–73.5 % at max_order 8, whatever N; AICc and FPE share that limit (their
+/// penalties differ from 2k by O(k²/N)). Measured with 200 draws (test
+/// `order_criteria_investigation`, `--ignored --nocapture`):
+/// - crate AIC (statsmodels' Burg variances, as the fixture) at max_order 5: AR(2) 67.5 /
+///   66.5 / 70.0 %, AR(3) 63.0 / 69.0 / 71.5 % for N = 100 / 500 / 5000; at max_order p + 1
+///   77.0–81.5 % (AR(2)), 70.5–79.0 % (AR(3));
+/// - AIC on the Levinson-recursive variances σ²_k = (1 − κ_k²) σ²_{k−1}: 7–9 points higher
+///   (AR(2) 74.5 / 77.5 / 78.0 %, AR(3) 70.0 / 76.5 / 77.5 %), i.e. at Shibata's limit —
+///   statsmodels' per-stage normalisation D_k / (2 (N − k)) adds O(1) noise to N ln σ²;
+/// - AICc and FPE within 2.5 points of AIC at N ≥ 500 (AICc up to 5 points better at
+///   N = 100); BIC 93–99.5 % except AR(3) at N = 100 (62–65 %, the AR(3) term too small
+///   for BIC's penalty on 100 samples).
+///
+/// So no length, maximum order (above p) or AIC variant reaches 90 %; the default stays
+/// the paper's AIC, and BIC (`ar_order_criterion: bic`) is the option that meets the target
+/// at N = 500 (next tests). Run with `--ignored` to see this test fail.
 #[test]
 #[ignore = "AIC cannot reach 90 % exact order (over-fits ~16-30 %); see the doc comment"]
 fn aic_order_hit_rate_reaches_issue_target() {
@@ -364,6 +379,216 @@ fn bic_order_hit_rate_reaches_issue_target() {
                 "BIC exact-order rate {}",
                 rates.0
             );
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Why AIC cannot reach the 90 % target: its asymptotic law (Shibata 1976).
+
+/// Shibata's (1976) limit of the probability that AIC picks the true order p when
+/// `spare_orders` L = max_order − p higher orders are tried.
+///
+/// Math note: for a true AR(p) and N → ∞, N ln(σ²_{p+j−1}/σ²_{p+j}) for j = 1..L tend to
+/// independent χ²₁ variables (the squared, √N-scaled spare reflection coefficients), so
+/// AIC(p + j) − AIC(p) → Σ_{i ≤ j} (2 − χ²₁,i), a random walk; the true order wins when
+/// every partial sum is positive (orders below p lose with probability → 1). For L = 1
+/// this is P(χ²₁ < 2) = erf(1) = 0.8427; it falls with L towards 0.71. No N and no
+/// variant of AIC that shares its asymptotics (AICc, FPE: their penalties differ from 2k
+/// by O(k²/N)) gets above erf(1) < 0.90 with even one spare order. Computed by simulating
+/// the random walk.
+fn shibata_exact_order_probability(spare_orders: usize, draws: usize, seed: u64) -> f64 {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let unit = Normal::new(0.0, 1.0).unwrap();
+    let hits = (0..draws)
+        .filter(|_| {
+            let mut walk = 0.0;
+            let mut positive = true;
+            for _ in 0..spare_orders {
+                let z: f64 = unit.sample(&mut rng);
+                walk += 2.0 - z * z;
+                positive &= walk > 0.0;
+            }
+            positive
+        })
+        .count();
+    hits as f64 / draws as f64
+}
+
+/// The order-selection criteria compared in the investigation, each computed from the
+/// Burg innovation variances σ²_k (k = 0..max_order) of one sequence of N samples.
+#[derive(Debug, Clone, Copy)]
+enum Criterion {
+    /// N ln σ²_k + 2k (the crate's and the fixture's AIC).
+    Aic,
+    /// Hurvich and Tsai's corrected AIC: AIC + 2(k + 1)(k + 2)/(N − k − 2).
+    Aicc,
+    /// Akaike's final prediction error in log form, N ln(σ²_k (N + k)/(N − k)) (zero mean).
+    Fpe,
+    /// N ln σ²_k + k ln N.
+    Bic,
+}
+
+impl Criterion {
+    fn score(self, n: usize, sigma2: f64, k: usize) -> f64 {
+        let (n_f, k_f) = (n as f64, k as f64);
+        let base = n_f * sigma2.ln();
+        match self {
+            Self::Aic => base + 2.0 * k_f,
+            Self::Aicc => base + 2.0 * k_f + 2.0 * (k_f + 1.0) * (k_f + 2.0) / (n_f - k_f - 2.0),
+            Self::Fpe => base + n_f * ((n_f + k_f) / (n_f - k_f)).ln(),
+            Self::Bic => base + k_f * n_f.ln(),
+        }
+    }
+}
+
+/// How the innovation variances σ²_k of the order path are computed from one Burg run.
+#[derive(Debug, Clone, Copy)]
+enum VariancePath {
+    /// statsmodels' (and the crate's) σ²_k = (1 − κ_k²) D_k / (2 (N − k)), D_k the summed
+    /// forward and backward error power of stage k.
+    Statsmodels,
+    /// The Levinson recursion σ²_k = (1 − κ_k²) σ²_{k−1} from σ²_0 = the mean square (as in
+    /// Matlab's arburg): each spare order changes N ln σ² only by N ln(1 − κ²).
+    Recursive,
+}
+
+fn variance_path(x: &[f64], max_order: usize, path: VariancePath) -> Vec<f64> {
+    match path {
+        VariancePath::Statsmodels => (0..=max_order)
+            .map(|k| burg(x, k).unwrap().innovation_variance)
+            .collect(),
+        VariancePath::Recursive => {
+            let model = burg(x, max_order).unwrap();
+            let mut sigma2 = vec![x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64];
+            for kappa in &model.reflection_coefficients {
+                let last = sigma2[sigma2.len() - 1];
+                sigma2.push(last * (1.0 - kappa * kappa));
+            }
+            sigma2
+        }
+    }
+}
+
+/// Exact-order rate of `criterion` over `draws` AR(`coeffs`) sequences of `n` samples.
+fn criterion_hit_rate(
+    coeffs: &[f64],
+    n: usize,
+    max_order: usize,
+    criterion: Criterion,
+    path: VariancePath,
+    draws: usize,
+    seed: u64,
+) -> f64 {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let hits = (0..draws)
+        .filter(|_| {
+            let x = ar_sequence(&mut rng, coeffs, n);
+            let best = variance_path(&x, max_order, path)
+                .iter()
+                .enumerate()
+                .map(|(k, &sigma2)| (k, criterion.score(n, sigma2, k)))
+                .fold(
+                    (0, f64::INFINITY),
+                    |best, c| if c.1 < best.1 { c } else { best },
+                );
+            best.0 == coeffs.len()
+        })
+        .count();
+    hits as f64 / draws as f64
+}
+
+/// AIC's exact-order rate against Shibata's limit. The limit is below the issue's 90 % for
+/// any number of spare orders (84.3 % with one, 76.0 % with the three of AR(2) at
+/// max_order 5, 78.7 % with the two of AR(3)), and AIC on the Levinson-recursive Burg
+/// variances reaches it on long sequences (within 3.5 binomial standard errors, 1000 draws
+/// of N = 5000), so the target is out of AIC's reach, not missed by a defect. The crate's
+/// AIC (statsmodels' per-stage variances, as the fixture) lies below the limit: its
+/// per-stage normalisation adds O(1) noise to N ln σ² (measured 7–9 points lower, see the
+/// investigation below).
+#[test]
+fn aic_exact_order_rate_tends_to_shibatas_limit_below_the_target() {
+    let l1 = shibata_exact_order_probability(1, 400_000, 3);
+    // erf(1) = P(χ²₁ < 2).
+    assert!((l1 - 0.842_700_79).abs() < 0.003, "Shibata L = 1: {l1}");
+    assert!(l1 < ORDER_HIT_TARGET);
+    for (coeffs, seed) in [(&AR2[..], 20), (&AR3[..], 21)] {
+        let spare = ORDER_TEST_MAX_ORDER - coeffs.len();
+        let limit = shibata_exact_order_probability(spare, 400_000, 4);
+        let draws = 1000;
+        let n = 5000;
+        let recursive = criterion_hit_rate(
+            coeffs,
+            n,
+            ORDER_TEST_MAX_ORDER,
+            Criterion::Aic,
+            VariancePath::Recursive,
+            draws,
+            seed,
+        );
+        let crate_aic = order_hit_rate(
+            coeffs,
+            n,
+            ORDER_TEST_MAX_ORDER,
+            OrderCriterion::Aic,
+            draws,
+            seed,
+        )
+        .0;
+        let se = (limit * (1.0 - limit) / draws as f64).sqrt();
+        println!(
+            "AIC AR{coeffs:?}, N={n}, max_order {ORDER_TEST_MAX_ORDER} ({spare} spare): Shibata limit \
+             {:.1} % (± {:.1} for {draws} draws); recursive variances {:.1} %, crate (statsmodels \
+             variances) {:.1} %",
+            100.0 * limit,
+            100.0 * se,
+            100.0 * recursive,
+            100.0 * crate_aic
+        );
+        assert!(limit < ORDER_HIT_TARGET, "limit {limit}");
+        assert!(
+            (recursive - limit).abs() < 3.5 * se,
+            "recursive AIC {recursive} vs limit {limit}"
+        );
+        assert!(crate_aic < limit + 3.5 * se, "crate AIC {crate_aic}");
+    }
+}
+
+/// The investigation behind the doc comments above: exact-order rates of AIC, AICc, FPE and
+/// BIC on the Burg variances for N = 100 (the estimator's window M), 500 and 5000 and
+/// max_order p + 1, 5 and 8, beside Shibata's limit. Prints only; run with `--ignored
+/// --nocapture`.
+#[test]
+#[ignore = "prints a table (the investigation of the AIC target); asserts nothing"]
+fn order_criteria_investigation() {
+    for (coeffs, seed) in [(&AR2[..], 10), (&AR3[..], 11)] {
+        for max_order in [coeffs.len() + 1, ORDER_TEST_MAX_ORDER, 8] {
+            let limit = shibata_exact_order_probability(max_order - coeffs.len(), 400_000, 4);
+            for n in [100, 500, 5000] {
+                for path in [VariancePath::Statsmodels, VariancePath::Recursive] {
+                    let rate = |c| {
+                        100.0
+                            * criterion_hit_rate(
+                                coeffs,
+                                n,
+                                max_order,
+                                c,
+                                path,
+                                ORDER_TEST_DRAWS,
+                                seed,
+                            )
+                    };
+                    println!(
+                        "AR{coeffs:?} max_order {max_order} N={n:>4} {path:?}: AIC {:5.1} %  \
+                         AICc {:5.1} %  FPE {:5.1} %  BIC {:5.1} %   (AIC limit {:.1} %)",
+                        rate(Criterion::Aic),
+                        rate(Criterion::Aicc),
+                        rate(Criterion::Fpe),
+                        rate(Criterion::Bic),
+                        100.0 * limit
+                    );
+                }
+            }
         }
     }
 }

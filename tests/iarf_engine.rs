@@ -266,66 +266,98 @@ fn with_q_factor(mut config: Config, factor: f64) -> Config {
     config
 }
 
-/// Ding, Wang and Rizos' claims, tightly coupled: with Q 10× too small or too large the
-/// Q-scaled EKF stays within 20 % of the tuned EKF's position RMSE while the untuned EKF
-/// does not; with Q right the scale settles near 1 (their figure 3).
-///
-/// Does not reproduce (measured, see the branch report): with Q right the scale falls to
-/// the floor 0.001 and the RMSE grows 1.46× (1.672 → 2.434 m); with Q × 0.1 the scale ends
-/// at 0.022 and the RMSE is 3.0× the tuned one, while the untuned EKF is 3 % better. With
-/// about nine pseudo-ranges of 3–17 m σ, tr R dominates tr(d dᵀ) so much that the
-/// numerator of eq. (19) over 64 epochs is negative in a sizeable share of the windows,
-/// where α is clamped to its floor: the scale random-walks downwards. Kept as the claim,
-/// ignored so that the suite stays green; run with `--ignored`.
-#[test]
-#[ignore = "Ding's Q-scaling claims do not reproduce on this drive (see the doc comment)"]
-fn ding_q_scaling_with_mis_set_process_noise() {
-    let laps = 4;
-    let tuned = run(Config::default(), laps, Feed::Ranges);
-    print_run("tuned ekf", &tuned);
-    let mut scaled_right = Config::default();
+/// Ding, Wang and Rizos' claims on `feed` from the tuned configuration `tuned_config`:
+/// with Q 10× too small or too large the Q-scaled EKF stays within 20 % of the tuned EKF's
+/// position RMSE while the untuned EKF does not (at least once); with Q right the scale
+/// settles near 1 (their figure 3). Prints every number before asserting.
+fn ding_claims(tuned_config: Config, feed: Feed, laps: usize) {
+    let label = match feed {
+        Feed::Ranges => "tight",
+        Feed::Fixes { .. } => "loose",
+    };
+    let tuned = run(tuned_config.clone(), laps, feed);
+    print_run(&format!("{label} tuned ekf"), &tuned);
+    let mut scaled_right = tuned_config.clone();
     scaled_right.filter.q_scaling = true;
-    let right = run(scaled_right.clone(), laps, Feed::Ranges);
-    print_run("q_scaling, Q right", &right);
+    let right = run(scaled_right.clone(), laps, feed);
+    print_run(&format!("{label} q_scaling, Q right"), &right);
     let scales: Vec<f64> = right.q_scales.iter().map(|(_, s)| *s).collect();
+    let last = *scales.last().unwrap();
     println!(
-        "Q right: scale at the end {:.3}, min {:.3}, max {:.3}",
-        scales.last().unwrap(),
+        "{label} Q right: scale at the end {last:.3}, min {:.3}, max {:.3}",
         scales.iter().cloned().fold(f64::INFINITY, f64::min),
         scales.iter().cloned().fold(0.0, f64::max)
     );
     let mut untuned_outside = 0;
+    let mut scaled_ratios = Vec::new();
     for factor in [0.1, 10.0] {
-        let untuned = run(with_q_factor(Config::default(), factor), laps, Feed::Ranges);
-        let scaled = run(
-            with_q_factor(scaled_right.clone(), factor),
-            laps,
-            Feed::Ranges,
-        );
-        print_run(&format!("ekf, Q × {factor}"), &untuned);
-        print_run(&format!("q_scaling, Q × {factor}"), &scaled);
-        println!(
-            "Q × {factor}: final scale {:.3} (ideal {:.3})",
-            scaled.q_scales.last().unwrap().1,
-            1.0 / factor
-        );
+        let untuned = run(with_q_factor(tuned_config.clone(), factor), laps, feed);
+        let scaled = run(with_q_factor(scaled_right.clone(), factor), laps, feed);
+        print_run(&format!("{label} ekf, Q × {factor}"), &untuned);
+        print_run(&format!("{label} q_scaling, Q × {factor}"), &scaled);
         let ratio = |r: &Run| r.rmse_3d_m / tuned.rmse_3d_m;
         println!(
-            "Q × {factor}: RMSE ratio to the tuned EKF: untuned {:.3}, q_scaling {:.3}",
+            "{label} Q × {factor}: final scale {:.3} (ideal {:.3}); RMSE ratio to the tuned EKF: \
+             untuned {:.3}, q_scaling {:.3}",
+            scaled.q_scales.last().unwrap().1,
+            1.0 / factor,
             ratio(&untuned),
             ratio(&scaled)
         );
-        assert!(
-            (ratio(&scaled) - 1.0).abs() <= 0.2,
-            "q_scaling, Q × {factor}"
-        );
+        scaled_ratios.push((factor, ratio(&scaled)));
         if (ratio(&untuned) - 1.0).abs() > 0.2 {
             untuned_outside += 1;
         }
     }
-    println!("untuned EKF outside ±20 % in {untuned_outside} of 2 cases");
-    let last = *scales.last().unwrap();
-    assert!((0.5..=2.0).contains(&last), "Q right: final scale {last}");
+    println!("{label}: untuned EKF outside ±20 % in {untuned_outside} of 2 cases");
+    for (factor, r) in scaled_ratios {
+        assert!(
+            (r - 1.0).abs() <= 0.2,
+            "{label} q_scaling, Q × {factor}: {r}"
+        );
+    }
+    assert!(
+        untuned_outside > 0,
+        "{label}: the untuned EKF is within 20 % both times"
+    );
+    assert!(
+        (0.5..=2.0).contains(&last),
+        "{label} Q right: final scale {last}"
+    );
+}
+
+/// Ding's claims tightly coupled. Do not reproduce (measured, see the branch report): with
+/// Q right the scale falls to the floor 0.001 and the RMSE grows 1.46× (1.672 → 2.434 m);
+/// with Q × 0.1 the scale ends at 0.022 and the RMSE is 3.0× the tuned one, while the
+/// untuned EKF is 3 % better. With about nine pseudo-ranges of 3–17 m σ, tr R dominates
+/// tr(d dᵀ) so much that the numerator of eq. (19) over 64 epochs is negative in a sizeable
+/// share of the windows, where α is clamped to its floor: the scale random-walks downwards.
+/// Kept as the claim, ignored so that the suite stays green; run with `--ignored`.
+#[test]
+#[ignore = "Ding's Q-scaling claims do not reproduce tightly coupled (see the doc comment)"]
+fn ding_q_scaling_with_mis_set_process_noise() {
+    ding_claims(Config::default(), Feed::Ranges, 4);
+}
+
+/// Ding's claims loosely coupled (their paper's set-up: position and velocity fixes), with
+/// the fixes' σ of 0.5 m and 0.05 m/s modelled exactly.
+///
+/// Does not reproduce either (measured, 4 laps, 1135 scored epochs): tuned EKF 0.259 m;
+/// with Q right the scale again ends at the floor 0.001 (RMSE 0.251 m); Q × 0.1: untuned
+/// EKF 0.934× the tuned RMSE, q_scaling 1.169× with its scale at 0.040 (ideal 10); Q × 10:
+/// untuned 1.048×, q_scaling 1.002× with its scale at 0.001 (ideal 0.1). q_scaling does
+/// stay within 20 %, but so does the untuned EKF: with 1 Hz fixes of 0.5 m and this IMU,
+/// the position error hardly depends on Q over two decades, and the eq. (19) ratio, whose
+/// numerator subtracts tr R from the innovation power, falls below the predicted power
+/// in most windows, so the scale keeps falling. Ignored like the tight test.
+#[test]
+#[ignore = "Ding's Q-scaling claims do not reproduce loosely coupled either (see the doc comment)"]
+fn ding_q_scaling_loosely_coupled() {
+    ding_claims(
+        loose_config(FilterVariant::Ekf),
+        Feed::Fixes { outliers: false },
+        4,
+    );
 }
 
 /// Every variant runs tightly coupled on the drive and stays within the open-sky budget of
@@ -371,4 +403,78 @@ fn residual_akf_loosely_coupled() {
     );
     print_run("loose residual_akf", &r);
     assert!(r.rmse_3d_m < 3f64.sqrt() * FIX_SIGMA_M);
+}
+
+/// The IARF paper's two cases loosely coupled on the default simulated scenario (the
+/// ERMAKF-like drive with foliage and buildings; the receiver-like fixes of `/gnss/fix`
+/// with their own covariance): case 1 as simulated, case 2 with the same scattered
+/// outliers as above (5 % of the fixes, 3–10 m per ENU axis, drawn with a fixed seed).
+/// Returns the 3D position RMSE of ckf, akf_all, akf_partial and iarf.
+fn default_scenario_loose(outliers: bool) -> [f64; 4] {
+    use adaptive_gnss_ins::sim::Scenario;
+    use adaptive_gnss_ins::tools::scenario_inputs::scenario_inputs;
+    use adaptive_gnss_ins::tools::session::{Session, SessionInput};
+    SCHEMES.map(|variant| {
+        let scenario = Scenario::builtin("default", 1).unwrap();
+        let mut config = Config::default();
+        config.filter.variant = variant;
+        config.filter.coupling = Coupling::Loose;
+        let mut session = Session::new(config, 0.0, None);
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let uniform = Uniform::new(0.0, 1.0).unwrap();
+        for input in scenario_inputs(&scenario) {
+            let input = match input.unwrap() {
+                SessionInput::Fix(mut fix) if outliers => {
+                    if uniform.sample(&mut rng) < OUTLIER_RATE {
+                        let d_enu = Vector3::from_fn(|_, _| {
+                            let size = OUTLIER_MIN_M
+                                + (OUTLIER_MAX_M - OUTLIER_MIN_M) * uniform.sample(&mut rng);
+                            if uniform.sample(&mut rng) < 0.5 {
+                                size
+                            } else {
+                                -size
+                            }
+                        });
+                        fix.position = earth::enu_to_llh(&d_enu, &fix.position).unwrap();
+                    }
+                    SessionInput::Fix(fix)
+                }
+                other => other,
+            };
+            session.push(input);
+        }
+        let s = session.finish().summary(f64::NEG_INFINITY);
+        println!(
+            "default scenario, loose, case {}: {:<12} 3D RMSE {:.3} m over {} epochs",
+            if outliers { 2 } else { 1 },
+            variant.as_str(),
+            s.pos_rmse_3d_m,
+            s.epochs
+        );
+        assert!(s.epochs > 3000, "{} scored epochs", s.epochs);
+        s.pos_rmse_3d_m
+    })
+}
+
+/// The IARF paper's case-2 ordering loosely coupled on the default scenario: IARF below
+/// AKF-PARTIAL below both CKF and AKF-ALL in 3D RMSE; case 1 is printed beside it.
+///
+/// Does not reproduce (measured, seed 1): case 1 CKF 5.497, AKF-ALL 14.521, AKF-PARTIAL
+/// 5.449, IARF 5.952 m; case 2 CKF 5.480, AKF-ALL 14.262, AKF-PARTIAL 5.439, IARF 6.048 m.
+/// AKF-PARTIAL is below CKF and AKF-ALL as claimed, but IARF is above AKF-PARTIAL and CKF.
+/// The scenario's fixes are single-point solutions whose error is metres of slowly varying
+/// bias (foliage, NLOS, the unmodelled 1.2× ionosphere), not white noise of the configured
+/// σ: the 3–10 m outliers hardly change anything (CKF 5.497 → 5.480 m), the double factor
+/// down-weights fixes for their biases, and AKF-ALL's α < 1 on those biased fixes inflates
+/// the prior at almost every epoch. On the test drive with white fix noise the ordering
+/// holds (`iarf_case_2_loosely_coupled_fixes_with_outliers`). Kept as the claim, ignored so
+/// that the suite stays green; run with `--ignored --nocapture`.
+#[test]
+#[ignore = "the IARF ordering does not reproduce on the default scenario (see the doc comment)"]
+fn iarf_cases_on_the_default_scenario_loosely_coupled() {
+    default_scenario_loose(false);
+    let [ckf, all, partial, iarf] = default_scenario_loose(true);
+    assert!(iarf < partial, "iarf {iarf} vs akf_partial {partial}");
+    assert!(partial < ckf, "akf_partial {partial} vs ckf {ckf}");
+    assert!(partial < all, "akf_partial {partial} vs akf_all {all}");
 }

@@ -69,10 +69,28 @@ fn sorted_quantile(sorted: &[f64], q: f64) -> f64 {
 ///
 /// Errors: fewer than 2 samples or a non-finite sample.
 pub fn robust_scale(samples: &[f64]) -> Result<f64, AdaptiveError> {
-    let std = sample_std(samples)?;
     let mut sorted = samples.to_vec();
     sorted.sort_by(f64::total_cmp);
-    let iqr = sorted_quantile(&sorted, 0.75) - sorted_quantile(&sorted, 0.25);
+    robust_scale_presorted(samples, &sorted)
+}
+
+/// [`robust_scale`] with the sorting done by the caller: `sorted` must hold the same values
+/// as `samples` in ascending order ([`f64::total_cmp`]). A caller that keeps a sliding
+/// window sorted as samples come and go saves a sort per sample; the result is the same to
+/// the bit, since the standard deviation is still summed in the order of `samples`.
+///
+/// Errors: fewer than 2 samples, a non-finite sample, or `sorted` of another length.
+pub fn robust_scale_presorted(samples: &[f64], sorted: &[f64]) -> Result<f64, AdaptiveError> {
+    let std = sample_std(samples)?;
+    if sorted.len() != samples.len() {
+        return Err(AdaptiveError::LengthMismatch {
+            what: "robust scale (sorted copy)",
+            left: samples.len(),
+            right: sorted.len(),
+        });
+    }
+    debug_assert!(sorted.windows(2).all(|w| w[0].total_cmp(&w[1]).is_le()));
+    let iqr = sorted_quantile(sorted, 0.75) - sorted_quantile(sorted, 0.25);
     let iqr_scale = iqr / 1.349;
     // A window whose middle half is one repeated value has IQR 0 but may still spread:
     // then the standard deviation is the only usable scale.
@@ -150,6 +168,21 @@ pub fn credibility(
     z: f64,
     kde_threshold: f64,
 ) -> Result<Credibility, AdaptiveError> {
+    let mut sorted = window.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    credibility_presorted(window, &sorted, z, kde_threshold)
+}
+
+/// [`credibility`] with the window's sorted copy kept by the caller (see
+/// [`robust_scale_presorted`]); the same result to the bit.
+///
+/// Errors: those of [`credibility`], and `sorted_window` of another length than `window`.
+pub fn credibility_presorted(
+    window: &[f64],
+    sorted_window: &[f64],
+    z: f64,
+    kde_threshold: f64,
+) -> Result<Credibility, AdaptiveError> {
     if !(kde_threshold > 0.0 && kde_threshold.is_finite()) {
         return Err(AdaptiveError::InvalidParameter {
             name: "kde_threshold",
@@ -157,7 +190,7 @@ pub fn credibility(
             reason: "must be positive and finite",
         });
     }
-    let window_scale = robust_scale(window)?;
+    let window_scale = robust_scale_presorted(window, sorted_window)?;
     let bandwidth = bandwidth_from_scale(window_scale, window.len())?;
     let density = kde_density(window, bandwidth, z)?;
     let threshold = gaussian_kernel(kde_threshold) / window_scale;
@@ -202,6 +235,25 @@ mod tests {
         assert!(credibility(&window, 0.0, 3.0).unwrap().credible);
         let sigma = sample_std(&window).unwrap();
         assert!(!credibility(&window, 10.0 * sigma, 3.0).unwrap().credible);
+    }
+
+    #[test]
+    fn presorted_credibility_is_the_same_to_the_bit() {
+        let window: Vec<f64> = (0..40)
+            .map(|i| ((i * 17) % 11) as f64 * 0.37 - 1.9)
+            .collect();
+        let mut sorted = window.clone();
+        sorted.sort_by(f64::total_cmp);
+        for z in [-5.0, -0.3, 0.0, 1.7, 9.0] {
+            assert_eq!(
+                credibility(&window, z, 3.0).unwrap(),
+                credibility_presorted(&window, &sorted, z, 3.0).unwrap()
+            );
+        }
+        assert!(matches!(
+            credibility_presorted(&window, &sorted[1..], 0.0, 3.0),
+            Err(AdaptiveError::LengthMismatch { .. })
+        ));
     }
 
     #[test]

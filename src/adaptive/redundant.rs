@@ -25,8 +25,8 @@ use std::collections::VecDeque;
 use super::ar_variance::{ar_corrected_variance, mean_square};
 use super::burg::{select_order, OrderCriterion};
 use super::error::{check_finite, AdaptiveError};
-use super::kde::{credibility, Credibility};
-use super::random_weighting::{random_weighted_second_moment, DirichletWeights};
+use super::kde::{credibility_presorted, Credibility};
+use super::random_weighting::DirichletWeights;
 
 /// Options of one [`RedundantNoiseEstimator`]; all counts are in epochs (samples).
 #[derive(Debug, Clone, PartialEq)]
@@ -190,6 +190,9 @@ pub enum RedundantEstimate {
 pub struct RedundantNoiseEstimator {
     options: RedundantNoiseOptions,
     window: VecDeque<f64>,
+    /// The window's values in ascending order ([`f64::total_cmp`]), kept as samples come
+    /// and go so that the KDE's quartiles need no sort per sample.
+    sorted: Vec<f64>,
     weights: DirichletWeights,
     regime: NoiseRegime,
     /// Consecutive samples that argue for leaving the current regime.
@@ -202,6 +205,7 @@ impl RedundantNoiseEstimator {
         options.validate()?;
         Ok(Self {
             window: VecDeque::with_capacity(options.window_size_m),
+            sorted: Vec::with_capacity(options.window_size_m),
             weights: DirichletWeights::new(options.seed),
             regime: NoiseRegime::Gaussian,
             streak: 0,
@@ -227,6 +231,7 @@ impl RedundantNoiseEstimator {
     /// Back to the state right after [`Self::new`], the random-weighting generator re-seeded.
     pub fn reset(&mut self) {
         self.window.clear();
+        self.sorted.clear();
         self.weights = DirichletWeights::new(self.options.seed);
         self.regime = NoiseRegime::Gaussian;
         self.streak = 0;
@@ -242,6 +247,7 @@ impl RedundantNoiseEstimator {
     /// ∇Z across the gap: it needs two consecutive epochs of both GNSS and INS.
     pub fn push_gap(&mut self) {
         self.window.clear();
+        self.sorted.clear();
         self.regime = NoiseRegime::Gaussian;
         self.streak = 0;
     }
@@ -264,9 +270,17 @@ impl RedundantNoiseEstimator {
         };
 
         if self.window.len() == self.options.window_size_m {
-            self.window.pop_front();
+            if let Some(oldest) = self.window.pop_front() {
+                if let Ok(at) = self.sorted.binary_search_by(|v| v.total_cmp(&oldest)) {
+                    self.sorted.remove(at);
+                }
+            }
         }
         self.window.push_back(nabla_z);
+        let at = self
+            .sorted
+            .partition_point(|v| v.total_cmp(&nabla_z).is_lt());
+        self.sorted.insert(at, nabla_z);
 
         if !ready {
             return Ok(RedundantEstimate::NotEnoughData {
@@ -292,11 +306,12 @@ impl RedundantNoiseEstimator {
     /// streak. A window without spread gives no verdict and leaves the streak unchanged.
     fn judge(&mut self, z: f64) -> Result<Option<Credibility>, AdaptiveError> {
         let window = self.window.make_contiguous();
-        let verdict = match credibility(window, z, self.options.kde_threshold) {
-            Ok(c) => c,
-            Err(AdaptiveError::ZeroVariance { .. }) => return Ok(None),
-            Err(e) => return Err(e),
-        };
+        let verdict =
+            match credibility_presorted(window, &self.sorted, z, self.options.kde_threshold) {
+                Ok(c) => c,
+                Err(AdaptiveError::ZeroVariance { .. }) => return Ok(None),
+                Err(e) => return Err(e),
+            };
         let argues_for_switch = match self.regime {
             NoiseRegime::Gaussian => !verdict.credible,
             NoiseRegime::NonGaussian => verdict.credible,
@@ -321,8 +336,7 @@ impl RedundantNoiseEstimator {
         let window = self.window.make_contiguous();
         match self.regime {
             NoiseRegime::Gaussian if self.options.random_weighting => {
-                let weights = self.weights.draw(window.len());
-                let moment = random_weighted_second_moment(window, &weights)?;
+                let moment = self.weights.second_moment(window)?;
                 Ok((moment / 2.0, VarianceMethod::RandomWeightedRmae))
             }
             NoiseRegime::Gaussian => Ok((mean_square(window)? / 2.0, VarianceMethod::Rmae)),
@@ -388,6 +402,30 @@ mod tests {
                 assert!((e.r_variance - 0.5).abs() < 1e-15);
             }
             other => panic!("expected an estimate, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn sorted_copy_follows_the_window() {
+        let mut est = RedundantNoiseEstimator::new(small_options()).unwrap();
+        for i in 0..60 {
+            // Repeated values, and both signed zeros, exercise removal of equal values.
+            let z = match i % 7 {
+                0 => 0.0,
+                1 => -0.0,
+                _ => ((i * 37) % 13) as f64 - 6.0,
+            };
+            est.push(z).unwrap();
+            let mut expected: Vec<f64> = est.window.iter().copied().collect();
+            expected.sort_by(f64::total_cmp);
+            assert_eq!(
+                est.sorted.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                expected.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+            );
+            if i == 30 {
+                est.push_gap();
+                assert!(est.sorted.is_empty());
+            }
         }
     }
 

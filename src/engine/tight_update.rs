@@ -197,10 +197,14 @@ pub fn update(
         }
     }
     if learn && adaptation.noise.wants_posterior_predictions() {
-        let posterior_hph: Vec<f64> = screened_rows
-            .iter()
-            .map(|row| (row * state.p * row.transpose())[(0, 0)])
-            .collect();
+        let posterior_hph: Vec<f64> = if adaptation.noise.wants_posterior_hph() {
+            screened_rows
+                .iter()
+                .map(|row| (row * state.p * row.transpose())[(0, 0)])
+                .collect()
+        } else {
+            Vec::new()
+        };
         let (rows, posterior) = posterior_predictions(state, epoch, w_ib_b_rad_s, config, screened);
         adaptation
             .noise
@@ -255,19 +259,28 @@ fn posterior_predictions(
     let rx_vel = geo.antenna_velocity_ecef_mps(&state.nav.v_n);
     let mut posterior = Vec::with_capacity(screened.len());
     let mut rows = Vec::with_capacity(screened.len());
+    // A satellite's pseudo-range and rate rows are adjacent: predict it once for both.
+    let mut last: Option<(usize, Option<SatPrediction>)> = None;
     for (obs_index, row) in screened {
-        let value = epoch.satellites.get(obs_index).and_then(|obs| {
-            geometry::predict(
-                obs,
-                &rx_pos,
-                &rx_vel,
-                state.clock_bias_m,
-                state.clock_drift_mps,
-                epoch.klobuchar.as_ref(),
-                epoch.gps_time_of_week_s,
-            )
-            .ok()
-        });
+        let value = match last {
+            Some((index, value)) if index == obs_index => value,
+            _ => {
+                let value = epoch.satellites.get(obs_index).and_then(|obs| {
+                    geometry::predict(
+                        obs,
+                        &rx_pos,
+                        &rx_vel,
+                        state.clock_bias_m,
+                        state.clock_drift_mps,
+                        epoch.klobuchar.as_ref(),
+                        epoch.gps_time_of_week_s,
+                    )
+                    .ok()
+                });
+                last = Some((obs_index, value));
+                value
+            }
+        };
         posterior.push(value.map_or(f64::NAN, |p| match row.observable {
             Observable::Pseudorange => p.pseudorange_m,
             Observable::PseudorangeRate => p.pseudorange_rate_mps,

@@ -103,19 +103,82 @@ const RELATIVE_HUMIDITY: f64 = 0.7;
 /// - Mapping to the slant: the Black & Eisner (1984) function
 ///   m(E) = 1.001 / sqrt(0.002001 + sin² E), the one of RTCA DO-229 for SBAS. Unlike
 ///   1 / sin E it stays finite at the horizon (≈ 22.4) and is within a few per cent of
-///   the Niell functions above 5°.
+///   the Niell functions above 5°. [`saastamoinen_mapped_delay_m`] takes another.
 /// - Elevations below the horizon are clamped to 0.
 /// - Outside [`TROPO_MODEL_MIN_HEIGHT_M`, `TROPO_MODEL_MAX_HEIGHT_M`] (or for a
 ///   non-finite height) the model is not valid and the function returns 0.
 pub fn saastamoinen_delay_m(p: &Llh, elevation_rad: f64) -> f64 {
+    saastamoinen_mapped_delay_m(p, elevation_rad, TropoMapping::BlackEisner)
+}
+
+/// Lowest elevation (rad) at which the cosecant mapping is evaluated: 1°, where it is
+/// 57.3. Choice: the plain 1 / sin E is infinite at the horizon; below 1° (far under any
+/// elevation mask) the 1° value is used so the delay stays finite, as the prediction of
+/// a satellite below the horizon during the first iterations of a solution needs.
+pub const COSECANT_MIN_ELEVATION_RAD: f64 = 1.0 * std::f64::consts::PI / 180.0;
+
+/// How a zenith tropospheric delay is mapped to the slant of a satellite's elevation E.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum TropoMapping {
+    /// Black & Eisner (1984), m(E) = 1.001 / sqrt(0.002001 + sin² E), RTCA DO-229's:
+    /// finite at the horizon (≈ 22.4), within a few per cent of the Niell functions
+    /// above 5°.
+    #[default]
+    BlackEisner,
+    /// m(E) = 1 / sin E (1 / cos z), floored at [`COSECANT_MIN_ELEVATION_RAD`]. It is
+    /// RTKLIB's (`tropmodel`), so selecting it reproduces RTKLIB's single-point
+    /// solutions; it exceeds Black & Eisner by 3 % at 10° and 0.3 % at 30°.
+    Cosecant,
+}
+
+impl TropoMapping {
+    /// The mapping factor at `elevation_rad` (clamped to [0, π/2]).
+    pub fn factor(self, elevation_rad: f64) -> f64 {
+        let el = elevation_rad.clamp(0.0, 0.5 * std::f64::consts::PI);
+        match self {
+            Self::BlackEisner => {
+                let sin_el = el.sin();
+                1.001 / (0.002001 + sin_el * sin_el).sqrt()
+            }
+            Self::Cosecant => 1.0 / el.max(COSECANT_MIN_ELEVATION_RAD).sin(),
+        }
+    }
+}
+
+/// The tropospheric delay model of a pseudo-range prediction.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TroposphereModel {
+    /// No tropospheric delay (for comparisons with tools run without one).
+    Off,
+    /// Saastamoinen zenith delays of the standard atmosphere with this mapping.
+    Saastamoinen(TropoMapping),
+}
+
+impl Default for TroposphereModel {
+    /// Saastamoinen with the Black & Eisner mapping.
+    fn default() -> Self {
+        Self::Saastamoinen(TropoMapping::BlackEisner)
+    }
+}
+
+impl TroposphereModel {
+    /// The delay (m) at the receiver `p` for a satellite at `elevation_rad`.
+    pub fn delay_m(self, p: &Llh, elevation_rad: f64) -> f64 {
+        match self {
+            Self::Off => 0.0,
+            Self::Saastamoinen(mapping) => saastamoinen_mapped_delay_m(p, elevation_rad, mapping),
+        }
+    }
+}
+
+/// Saastamoinen tropospheric delay (m) as [`saastamoinen_delay_m`], with the zenith
+/// delays mapped to the slant by `mapping`.
+pub fn saastamoinen_mapped_delay_m(p: &Llh, elevation_rad: f64, mapping: TropoMapping) -> f64 {
     let h = p.height_m;
     if !(TROPO_MODEL_MIN_HEIGHT_M..=TROPO_MODEL_MAX_HEIGHT_M).contains(&h) {
         return 0.0;
     }
-    let zenith = saastamoinen_zenith_delay_m(p.lat_rad, h);
-    let sin_el = elevation_rad.clamp(0.0, 0.5 * std::f64::consts::PI).sin();
-    let mapping = 1.001 / (0.002001 + sin_el * sin_el).sqrt();
-    zenith * mapping
+    saastamoinen_zenith_delay_m(p.lat_rad, h) * mapping.factor(elevation_rad)
 }
 
 /// Saastamoinen zenith delay (m), hydrostatic plus wet, of the standard atmosphere at
@@ -264,5 +327,30 @@ mod tests {
         }
         let top = Llh::from_degrees(45.0, 10.0, TROPO_MODEL_MAX_HEIGHT_M);
         assert!(saastamoinen_delay_m(&top, 0.5) > 0.0);
+    }
+
+    #[test]
+    fn cosecant_mapping_is_one_over_sine_with_a_floor() {
+        let p = Llh::from_degrees(40.2, -105.1, 1560.0);
+        let zenith = saastamoinen_delay_m(&p, std::f64::consts::FRAC_PI_2);
+        let cosecant = TroposphereModel::Saastamoinen(TropoMapping::Cosecant);
+        for el_deg in [5.0f64, 10.0, 30.0, 60.0, 90.0] {
+            let el = el_deg.to_radians();
+            let d = cosecant.delay_m(&p, el);
+            assert!((d - zenith / el.sin()).abs() < 1e-9, "{el_deg}°: {d}");
+            // Against Black & Eisner: equal at the zenith (to its 1.001 / sqrt(1.002001)
+            // = 1.0000), larger toward the horizon.
+            let be = saastamoinen_delay_m(&p, el);
+            assert!(d >= be - 1e-6 * zenith, "{el_deg}°: {d} < {be}");
+        }
+        let floor = cosecant.delay_m(&p, COSECANT_MIN_ELEVATION_RAD);
+        assert_eq!(cosecant.delay_m(&p, 0.0), floor);
+        assert_eq!(cosecant.delay_m(&p, -0.3), floor);
+        assert!(floor.is_finite() && floor > 50.0 * zenith);
+        assert_eq!(TroposphereModel::Off.delay_m(&p, 0.2), 0.0);
+        assert_eq!(
+            TroposphereModel::default().delay_m(&p, 0.2),
+            saastamoinen_delay_m(&p, 0.2)
+        );
     }
 }

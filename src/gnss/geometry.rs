@@ -20,7 +20,7 @@ use thiserror::Error;
 use crate::earth::{
     ecef_to_llh, rot_ecef_to_enu, Llh, EARTH_RATE_RAD_S, SEMI_MINOR_AXIS_M, SPEED_OF_LIGHT_M_S,
 };
-use crate::gnss::atmosphere::{klobuchar_delay_m, saastamoinen_delay_m};
+use crate::gnss::atmosphere::{klobuchar_delay_m, TroposphereModel};
 use crate::gnss::{Klobuchar, SatId, SatObservation};
 
 /// Smallest receiver–satellite distance (m) for which the line of sight is accepted.
@@ -188,6 +188,17 @@ pub struct SatPrediction {
     pub pseudorange_rate_mps: f64,
 }
 
+/// The delay models of a prediction.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DelayModels<'a> {
+    /// Klobuchar coefficients; None: no ionospheric delay.
+    pub klobuchar: Option<&'a Klobuchar>,
+    /// GPS time of week (s), for Klobuchar's local time.
+    pub gps_tow_s: f64,
+    /// Tropospheric delay model.
+    pub troposphere: TroposphereModel,
+}
+
 /// Predicted pseudo-range and rate of `obs` for a receiver at `rx_pos_ecef_m` moving at
 /// `rx_vel_ecef_mps` (ECEF), with clock bias `clock_bias_m` (c·δt_u) and drift
 /// `clock_drift_mps` (c·δṫ_u):
@@ -196,6 +207,7 @@ pub struct SatPrediction {
 /// Delays: the observation's own `iono_delay_m` / `tropo_delay_m` when present; otherwise
 /// the Klobuchar model when `klobuchar` is given (else no ionospheric delay) and the
 /// Saastamoinen model. `gps_tow_s` is the GPS time of week (for Klobuchar's local time).
+/// [`predict_with`] takes another troposphere model.
 ///
 /// Choice: the atmospheric delays' rates (millimetres per second at most) are not part of
 /// the rate model.
@@ -208,6 +220,36 @@ pub fn predict(
     klobuchar: Option<&Klobuchar>,
     gps_tow_s: f64,
 ) -> Result<SatPrediction, GnssModelError> {
+    let models = DelayModels {
+        klobuchar,
+        gps_tow_s,
+        troposphere: TroposphereModel::default(),
+    };
+    predict_with(
+        obs,
+        rx_pos_ecef_m,
+        rx_vel_ecef_mps,
+        clock_bias_m,
+        clock_drift_mps,
+        &models,
+    )
+}
+
+/// [`predict`] with the delay models given: a tropospheric delay the observation does
+/// not carry comes from `models.troposphere`.
+pub fn predict_with(
+    obs: &SatObservation,
+    rx_pos_ecef_m: &Vector3<f64>,
+    rx_vel_ecef_mps: &Vector3<f64>,
+    clock_bias_m: f64,
+    clock_drift_mps: f64,
+    models: &DelayModels<'_>,
+) -> Result<SatPrediction, GnssModelError> {
+    let DelayModels {
+        klobuchar,
+        gps_tow_s,
+        troposphere,
+    } = *models;
     let sat = obs.sat;
     let scalars = [
         (clock_bias_m, "receiver clock bias"),
@@ -238,7 +280,7 @@ pub fn predict(
     };
     let tropo_m = obs
         .tropo_delay_m
-        .unwrap_or_else(|| saastamoinen_delay_m(&rx, elevation_rad));
+        .unwrap_or_else(|| troposphere.delay_m(&rx, elevation_rad));
     if !iono_m.is_finite() {
         return Err(GnssModelError::NonFinite {
             sat,
@@ -283,6 +325,7 @@ fn check_finite(sat: SatId, v: &Vector3<f64>, what: &'static str) -> Result<(), 
 mod tests {
     use super::*;
     use crate::earth::{llh_to_ecef, SEMI_MAJOR_AXIS_M};
+    use crate::gnss::atmosphere::saastamoinen_delay_m;
     use crate::gnss::Constellation;
 
     const G01: SatId = SatId {
@@ -496,6 +539,35 @@ mod tests {
         let expected_iono = klobuchar_delay_m(&k, &rx, q.azimuth_rad, q.elevation_rad, 1000.0);
         assert_eq!(q.iono_m, expected_iono);
         assert!(q.iono_m > 0.0);
+        // Another troposphere model changes the delay and nothing else.
+        obs.tropo_delay_m = None;
+        let q = predict(
+            &obs,
+            &r_rx,
+            &Vector3::zeros(),
+            1234.0,
+            -5.0,
+            Some(&k),
+            1000.0,
+        )
+        .unwrap();
+        assert_eq!(q.tropo_m, saastamoinen_delay_m(&rx, q.elevation_rad));
+        for troposphere in [
+            TroposphereModel::Off,
+            TroposphereModel::Saastamoinen(crate::gnss::atmosphere::TropoMapping::Cosecant),
+        ] {
+            let models = DelayModels {
+                klobuchar: Some(&k),
+                gps_tow_s: 1000.0,
+                troposphere,
+            };
+            let t = predict_with(&obs, &r_rx, &Vector3::zeros(), 1234.0, -5.0, &models).unwrap();
+            assert_eq!(t.tropo_m, troposphere.delay_m(&rx, t.elevation_rad));
+            assert_ne!(t.tropo_m, q.tropo_m);
+            assert_eq!(t.iono_m, q.iono_m);
+            let expected = q.pseudorange_m - q.tropo_m + t.tropo_m;
+            assert!((t.pseudorange_m - expected).abs() < 1e-6);
+        }
     }
 
     #[test]

@@ -3,9 +3,12 @@
 
 pub mod atmosphere;
 pub mod ephemeris;
+pub mod epoch_build;
 pub mod geometry;
 mod observation;
 pub mod rinex_nav;
+pub mod rinex_obs;
+pub mod rinex_spp;
 pub mod spp;
 pub mod ubx;
 

@@ -20,7 +20,7 @@ const SHORT_RECORD_LINES: usize = 3;
 const FIELD_WIDTH: usize = 19;
 /// Days from 0000-03-01 (proleptic Gregorian) to 1980-01-06, in [`days_from_civil`]'s
 /// count.
-const GPS_EPOCH_DAYS: i64 = 723_125;
+pub(crate) const GPS_EPOCH_DAYS: i64 = 723_125;
 
 /// Errors of the RINEX navigation reader, with the 1-based line number.
 #[derive(Debug, Error, Clone, PartialEq, Eq)]
@@ -293,7 +293,7 @@ fn header_klobuchar(header: &[&str]) -> Option<Klobuchar> {
 
 /// Days since 0000-03-01 of a proleptic Gregorian date (H. Hinnant's civil-days
 /// algorithm, re-derived: years start in March so the leap day is last).
-fn days_from_civil(year: i64, month: i64, day: i64) -> i64 {
+pub(crate) fn days_from_civil(year: i64, month: i64, day: i64) -> i64 {
     let y = if month <= 2 { year - 1 } else { year };
     let era = y.div_euclid(400);
     let yoe = y - era * 400;

@@ -30,7 +30,10 @@ use nalgebra::{Matrix3, Matrix4, Vector3, Vector4};
 use thiserror::Error;
 
 use crate::earth::{ecef_to_llh, rot_ecef_to_enu, Llh, SPEED_OF_LIGHT_M_S};
-use crate::gnss::geometry::{line_of_sight, predict, GnssModelError, SatPrediction};
+use crate::gnss::atmosphere::TroposphereModel;
+use crate::gnss::geometry::{
+    line_of_sight, predict_with, DelayModels, GnssModelError, SatPrediction,
+};
 use crate::gnss::{GnssEpoch, SatId, SatObservation};
 
 /// Height band (± m about the ellipsoid) within which the iterate counts as "near the
@@ -113,11 +116,14 @@ pub struct SppConfig {
     /// Threshold on the standardized residual |w| for excluding the worst satellite;
     /// None disables the outlier test.
     pub outlier_threshold: Option<f64>,
+    /// Tropospheric delay model for satellites whose observation carries no delay.
+    pub troposphere: TroposphereModel,
 }
 
 impl Default for SppConfig {
     /// Mask 10°, default σ model, start at the earth's centre, 20 iterations,
-    /// tolerance 0.1 mm, outlier threshold |w| > 4.
+    /// tolerance 0.1 mm, outlier threshold |w| > 4, Saastamoinen troposphere with the
+    /// Black & Eisner mapping.
     fn default() -> Self {
         Self {
             elevation_mask_rad: 10f64.to_radians(),
@@ -126,6 +132,7 @@ impl Default for SppConfig {
             max_iterations: 20,
             convergence_m: 1e-4,
             outlier_threshold: Some(4.0),
+            troposphere: TroposphereModel::default(),
         }
     }
 }
@@ -374,6 +381,11 @@ fn evaluate(
     let llh = ecef_to_llh(pos);
     let near_surface = llh.is_some_and(|p| p.height_m.abs() <= NEAR_SURFACE_HEIGHT_M);
     let zero = Vector3::zeros();
+    let models = DelayModels {
+        klobuchar: epoch.klobuchar.as_ref(),
+        gps_tow_s: epoch.gps_time_of_week_s,
+        troposphere: config.troposphere,
+    };
     let mut rows = Vec::new();
     let mut excluded = Vec::new();
     for (index, obs) in epoch.satellites.iter().enumerate() {
@@ -394,16 +406,7 @@ fn evaluate(
         }
         // Predicted pseudo-range, line of sight, elevation (if defined) and the prediction.
         let modelled = if llh.is_some() {
-            predict(
-                obs,
-                pos,
-                &zero,
-                clock_bias_m,
-                0.0,
-                epoch.klobuchar.as_ref(),
-                epoch.gps_time_of_week_s,
-            )
-            .map(|p| {
+            predict_with(obs, pos, &zero, clock_bias_m, 0.0, &models).map(|p| {
                 let predicted = if near_surface {
                     p.pseudorange_m
                 } else {

@@ -10,6 +10,7 @@
 //! - [`bag`]: rosbag2-compatible MCAP bag writing and streaming reading.
 //! - [`args`]: the node's `--ros-args` command line; [`names`]: topic-name resolution.
 //! - [`node`]: the `gnss_ins_node` ROS 2 node (ros2-client) around the engine.
+//! - [`player`]: `gnss_ins play`, a recorded bag published onto DDS.
 
 pub mod args;
 pub mod bag;
@@ -19,3 +20,4 @@ pub mod msg;
 pub mod names;
 pub mod node;
 pub mod outbound;
+pub mod player;

@@ -275,18 +275,30 @@ pub(crate) fn fix_of(msg: &NavSatFix, t_s: f64) -> GnssFix {
 
 /// A reference sample at `t_s` from Odometry in the ENU frame at `datum` (None when the
 /// position does not convert).
+///
+/// A reference without attitude (a GNSS trajectory, as `convert` writes) has the all-zero
+/// quaternion; its twist is then in the pose's own frame (`child_frame_id` equal to
+/// `header.frame_id`: the ENU velocity). A twist whose covariance starts with −1 is not
+/// provided.
 fn truth_of(msg: &Odometry, t_s: f64, datum: &Llh) -> Option<TruthSample> {
     let p = &msg.pose.pose.position;
     let llh = earth::enu_to_llh(&nalgebra::Vector3::new(p.x, p.y, p.z), datum)?;
     let o = &msg.pose.pose.orientation;
-    let q_nb =
-        nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(o.w, o.x, o.y, o.z));
+    let q = nalgebra::Quaternion::new(o.w, o.x, o.y, o.z);
+    let q_nb = (q.norm() > 0.0).then(|| nalgebra::UnitQuaternion::from_quaternion(q));
     let v = &msg.twist.twist.linear;
-    let v_n = q_nb * nalgebra::Vector3::new(v.x, v.y, v.z);
+    let v = nalgebra::Vector3::new(v.x, v.y, v.z);
+    let v_n = if msg.twist.covariance[0] < 0.0 {
+        None
+    } else if msg.child_frame_id == msg.header.frame_id {
+        Some(v)
+    } else {
+        q_nb.map(|q| q * v)
+    };
     Some(TruthSample {
         t_s,
         p: llh,
-        v_n: Some(v_n),
-        q_nb: Some(q_nb),
+        v_n,
+        q_nb,
     })
 }

@@ -9,7 +9,11 @@ use clap::{Subcommand, ValueEnum};
 use crate::config::{Config, FilterVariant};
 use crate::sim::{Scenario, ScenarioSpec};
 
-use super::compare::{format_csv, format_table, ComparisonRow};
+use super::cli_play::{self, PlayArgs};
+use super::cli_real::{self, ConvertArgs, SppArgs, SppRinexArgs};
+use super::compare::{
+    format_csv, format_environment_table, format_table, ComparisonRow, EnvironmentRow,
+};
 use super::plots::{write_plots, FilterRun};
 use super::replay::{self, ReplayOptions, TruthSource};
 use super::session::{Session, SessionReport};
@@ -58,8 +62,16 @@ pub enum Command {
         #[arg(long, value_delimiter = ',')]
         filters: Vec<String>,
         /// Folder of parameter files named <variant>.yaml (else the defaults).
-        #[arg(long)]
+        #[arg(long, conflicts_with = "params")]
         params_dir: Option<PathBuf>,
+        /// One parameter file (e.g. a sensor description) for every variant, its
+        /// filter.variant replaced by each variant in turn.
+        #[arg(long)]
+        params: Option<PathBuf>,
+        /// Also tabulate the errors by environment (simulated segments, or the reference's
+        /// solution quality in a converted bag: rtk_fixed, rtk_float).
+        #[arg(long)]
+        by_environment: bool,
         #[arg(long, value_enum, default_value_t = Format::Table)]
         format: Format,
         /// Folder for PNG and SVG figures of the errors over time and of the estimated
@@ -67,11 +79,22 @@ pub enum Command {
         #[arg(long)]
         plots: Option<PathBuf>,
     },
+    /// Convert a u-blox UBX log and an IMU CSV (and a reference) into a bag.
+    Convert(ConvertArgs),
+    /// Single-point solutions of every epoch of a bag or UBX log, scored against its
+    /// reference.
+    Spp(SppArgs),
     /// Simulate the default scenario into a temporary folder and compare every variant.
     Demo {
         #[arg(long, default_value_t = 1)]
         seed: u64,
     },
+    /// Publish a bag onto DDS (domain `ROS_DOMAIN_ID`) with its recorded topic names and
+    /// types, paced by its log times, like `ros2 bag play`.
+    Play(PlayArgs),
+    /// Single-point positions of every epoch of a RINEX 3 observation file with RTKLIB
+    /// rnx2rtkp's single-point settings (GPS L1 C/A, 10° mask, Klobuchar, Saastamoinen).
+    SppRinex(SppRinexArgs),
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -177,12 +200,31 @@ pub fn run(command: Command) -> Result<(), String> {
             bag,
             filters,
             params_dir,
+            params,
+            by_environment,
             format,
             plots,
         } => {
-            let runs = compare_bag(&bag, &filters, params_dir.as_deref())?;
+            let base = match &params {
+                Some(p) => Some(load_config(Some(p))?),
+                None => None,
+            };
+            let runs = compare_bag(&bag, &filters, params_dir.as_deref(), base.as_ref())?;
             let rows: Vec<ComparisonRow> = runs.iter().map(|(row, _)| row.clone()).collect();
             print!("{}", render(&rows, format)?);
+            if by_environment {
+                let rows: Vec<EnvironmentRow> = runs
+                    .iter()
+                    .flat_map(|(row, report)| {
+                        EnvironmentRow::rows(
+                            &row.filter,
+                            &report.summary_by_environment(f64::NEG_INFINITY),
+                        )
+                    })
+                    .collect();
+                println!();
+                print!("{}", format_environment_table(&rows));
+            }
             if let Some(dir) = plots {
                 let runs: Vec<FilterRun> = runs
                     .into_iter()
@@ -196,6 +238,10 @@ pub fn run(command: Command) -> Result<(), String> {
             }
             Ok(())
         }
+        Command::Play(args) => cli_play::play(args),
+        Command::Convert(args) => cli_real::convert(args),
+        Command::Spp(args) => cli_real::spp(args),
+        Command::SppRinex(args) => cli_real::spp_rinex(args),
         Command::Demo { seed } => {
             let dir = std::env::temp_dir().join(format!("gnss_ins_demo_{}", std::process::id()));
             std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
@@ -208,7 +254,7 @@ pub fn run(command: Command) -> Result<(), String> {
                 bag.display(),
                 scenario.duration_s()
             );
-            let runs = compare_bag(&bag, &[], None)?;
+            let runs = compare_bag(&bag, &[], None, None)?;
             let rows: Vec<ComparisonRow> = runs.into_iter().map(|(row, _)| row).collect();
             print!("{}", format_table(&rows));
             Ok(())
@@ -262,7 +308,7 @@ fn load_scenario(name_or_file: &str, seed: u64) -> Result<Scenario, String> {
     Scenario::new(spec, seed).map_err(|e| e.to_string())
 }
 
-fn load_config(path: Option<&Path>) -> Result<Config, String> {
+pub(super) fn load_config(path: Option<&Path>) -> Result<Config, String> {
     match path {
         None => Ok(Config::default()),
         Some(p) => {
@@ -272,9 +318,13 @@ fn load_config(path: Option<&Path>) -> Result<Config, String> {
     }
 }
 
-/// The configuration of one variant: `<dir>/<variant>.yaml` when present, else the
-/// defaults with that variant.
-fn variant_config(name: &str, params_dir: Option<&Path>) -> Result<Config, String> {
+/// The configuration of one variant: `<dir>/<variant>.yaml` when present, else `base`
+/// (or the defaults) with that variant.
+fn variant_config(
+    name: &str,
+    params_dir: Option<&Path>,
+    base: Option<&Config>,
+) -> Result<Config, String> {
     if let Some(dir) = params_dir {
         let path = dir.join(format!("{name}.yaml"));
         if path.exists() {
@@ -288,7 +338,7 @@ fn variant_config(name: &str, params_dir: Option<&Path>) -> Result<Config, Strin
             let known: Vec<&str> = FilterVariant::ALL.iter().map(|v| v.as_str()).collect();
             format!("unknown filter '{name}' (known: {})", known.join(", "))
         })?;
-    let mut config = Config::default();
+    let mut config = base.cloned().unwrap_or_default();
     config.filter.variant = variant;
     Ok(config)
 }
@@ -298,6 +348,7 @@ fn compare_bag(
     bag: &Path,
     filters: &[String],
     params_dir: Option<&Path>,
+    base: Option<&Config>,
 ) -> Result<Vec<(ComparisonRow, SessionReport)>, String> {
     let names: Vec<String> = if filters.is_empty() {
         FilterVariant::ALL
@@ -309,7 +360,7 @@ fn compare_bag(
     };
     let mut rows = Vec::new();
     for name in names {
-        let config = variant_config(&name, params_dir)?;
+        let config = variant_config(&name, params_dir, base)?;
         let inputs =
             replay::bag_inputs(bag, Some(TRUTH_TOPIC.to_owned())).map_err(|e| e.to_string())?;
         let start = Instant::now();

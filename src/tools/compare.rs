@@ -97,3 +97,58 @@ pub fn format_csv(rows: &[ComparisonRow]) -> String {
     }
     out
 }
+
+/// One row of a comparison by environment (a simulated segment, or a real reference's
+/// solution quality such as `rtk_fixed` and `rtk_float`).
+#[derive(Debug, Clone, Serialize)]
+pub struct EnvironmentRow {
+    pub filter: String,
+    pub environment: String,
+    pub epochs: usize,
+    pub pos_rmse_horizontal_m: f64,
+    pub pos_rmse_u_m: f64,
+    pub pos_rmse_3d_m: f64,
+    pub vel_rmse_3d_mps: f64,
+}
+
+impl EnvironmentRow {
+    /// One row per environment of `by_environment`.
+    pub fn rows(
+        filter: &str,
+        by_environment: &std::collections::BTreeMap<String, ErrorSummary>,
+    ) -> Vec<Self> {
+        by_environment
+            .iter()
+            .map(|(environment, s)| Self {
+                filter: filter.to_owned(),
+                environment: environment.clone(),
+                epochs: s.epochs,
+                pos_rmse_horizontal_m: s.pos_rmse_horizontal_m,
+                pos_rmse_u_m: s.pos_rmse_u_m,
+                pos_rmse_3d_m: s.pos_rmse_3d_m,
+                vel_rmse_3d_mps: s.vel_rmse_3d_mps,
+            })
+            .collect()
+    }
+}
+
+/// The comparison by environment as an aligned text table.
+pub fn format_environment_table(rows: &[EnvironmentRow]) -> String {
+    let mut out = format!(
+        "{:<14} {:<14} {:>7} {:>8} {:>8} {:>8} {:>9}\n",
+        "filter", "environment", "epochs", "horiz_m", "vert_m", "pos3d_m", "vel_mps"
+    );
+    for r in rows {
+        out.push_str(&format!(
+            "{:<14} {:<14} {:>7} {:>8.3} {:>8.3} {:>8.3} {:>9.4}\n",
+            r.filter,
+            r.environment,
+            r.epochs,
+            r.pos_rmse_horizontal_m,
+            r.pos_rmse_u_m,
+            r.pos_rmse_3d_m,
+            r.vel_rmse_3d_mps
+        ));
+    }
+    out
+}

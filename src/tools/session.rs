@@ -91,6 +91,13 @@ impl SessionReport {
     }
 }
 
+/// Largest time between a streamed reference sample and the solution it is scored against
+/// when none coincides with it (a real reference at GNSS epochs, solutions at IMU samples).
+/// Choice: a few IMU intervals at 100-200 Hz; the reference is moved to the solution's time
+/// with its own velocity (when it has one), so a walk or a drive loses nothing to the
+/// offset, and without a velocity it costs at most speed · 20 ms.
+pub const MAX_TRUTH_OFFSET_S: f64 = 0.02;
+
 /// Drives an [`Engine`] and scores its solutions.
 pub struct Session {
     engine: Engine,
@@ -100,6 +107,9 @@ pub struct Session {
     /// A preloaded reference (e.g. a CSV); otherwise references come as inputs.
     track: Option<TruthTrack>,
     latest: Option<Solution>,
+    /// A streamed reference sample newer than the latest solution, with its environment,
+    /// waiting for the next solution.
+    waiting_truth: Option<(TruthSample, String)>,
     environment: String,
     truth_sigmas: HashMap<u64, Vec<(SatId, f64, f64)>>,
     report: SessionReport,
@@ -118,6 +128,7 @@ impl Session {
             last_scored_t_s: f64::NEG_INFINITY,
             track,
             latest: None,
+            waiting_truth: None,
             environment: "unlabelled".to_owned(),
             truth_sigmas: HashMap::new(),
             report: SessionReport::default(),
@@ -172,10 +183,12 @@ impl Session {
                     let t = sol.nav.t_s;
                     if t - self.last_scored_t_s >= self.score_interval_s {
                         if let Some(truth) = track.at(t) {
-                            self.record(sol, &truth);
+                            let environment = self.environment.clone();
+                            self.record(sol, &truth, environment);
                         }
                     }
                 }
+                self.score_waiting(sol);
                 self.latest = Some((**sol).clone());
             }
             Output::Epoch(report) => {
@@ -186,22 +199,80 @@ impl Session {
         }
     }
 
+    /// Scores a streamed reference sample against the solution of its time, or holds it
+    /// for the next solution when it falls between two (see [`MAX_TRUTH_OFFSET_S`]).
     fn score_streamed(&mut self, truth: &TruthSample) {
         let Some(sol) = self.latest.take() else {
             return;
         };
-        if (sol.nav.t_s - truth.t_s).abs() < 1e-6
-            && truth.t_s - self.last_scored_t_s >= self.score_interval_s
-        {
-            self.record(&sol, truth);
+        if truth.t_s - self.last_scored_t_s >= self.score_interval_s {
+            let environment = self.environment.clone();
+            if (sol.nav.t_s - truth.t_s).abs() < 1e-6 {
+                self.record(&sol, truth, environment);
+            } else if sol.nav.t_s < truth.t_s {
+                // An older sample still waiting has no nearer solution than the latest.
+                if let Some((old, env)) = self.waiting_truth.take() {
+                    self.record_nearest(&sol, None, &old, env);
+                }
+                self.waiting_truth = Some((*truth, environment));
+            } else {
+                self.record_nearest(&sol, None, truth, environment);
+            }
         }
         self.latest = Some(sol);
     }
 
-    fn record(&mut self, sol: &Solution, truth: &TruthSample) {
+    /// Scores the waiting reference sample once `sol` reaches its time, against the nearer
+    /// of `sol` and the latest solution before it.
+    fn score_waiting(&mut self, sol: &Solution) {
+        let due = self
+            .waiting_truth
+            .as_ref()
+            .is_some_and(|(truth, _)| sol.nav.t_s >= truth.t_s);
+        if !due {
+            return;
+        }
+        if let Some((truth, environment)) = self.waiting_truth.take() {
+            let before = self.latest.take();
+            self.record_nearest(sol, before.as_ref(), &truth, environment);
+            self.latest = before;
+        }
+    }
+
+    /// Scores `truth` against the nearer of `a` and `b` when within [`MAX_TRUTH_OFFSET_S`],
+    /// moving the reference to the solution's time with its velocity.
+    fn record_nearest(
+        &mut self,
+        a: &Solution,
+        b: Option<&Solution>,
+        truth: &TruthSample,
+        environment: String,
+    ) {
+        let offset = |s: &Solution| (s.nav.t_s - truth.t_s).abs();
+        let sol = match b {
+            Some(b) if offset(b) < offset(a) => b,
+            _ => a,
+        };
+        if offset(sol) > MAX_TRUTH_OFFSET_S {
+            return;
+        }
+        let dt = sol.nav.t_s - truth.t_s;
+        let p = truth
+            .v_n
+            .and_then(|v| crate::earth::enu_to_llh(&(v * dt), &truth.p))
+            .unwrap_or(truth.p);
+        let moved = TruthSample {
+            t_s: sol.nav.t_s,
+            p,
+            ..*truth
+        };
+        self.record(sol, &moved, environment);
+    }
+
+    fn record(&mut self, sol: &Solution, truth: &TruthSample, environment: String) {
         self.last_scored_t_s = sol.nav.t_s;
         let error = eval::solution_error(sol, truth);
-        self.report.errors.push((self.environment.clone(), error));
+        self.report.errors.push((environment, error));
     }
 
     fn record_sigmas(&mut self, report: &EpochReport) {

@@ -116,8 +116,16 @@ impl NoiseModel {
         matches!(self, Self::Redundant(_) | Self::Residual(_))
     }
 
+    /// True when the strategy also needs h P̂ hᵀ of the posterior covariance per
+    /// measurement (only the residual-based one; the redundant-measurement estimators are
+    /// independent of the state's covariance, and the 24 products cost more than their
+    /// whole KDE).
+    pub fn wants_posterior_hph(&self) -> bool {
+        matches!(self, Self::Residual(_))
+    }
+
     /// Hands over the measurements with their predictions from the corrected state and
-    /// their h P̂ hᵀ of the posterior covariance.
+    /// their h P̂ hᵀ of the posterior covariance (empty unless [`Self::wants_posterior_hph`]).
     pub fn after_update(
         &mut self,
         t_s: f64,

@@ -23,9 +23,10 @@ mod rawx;
 mod reader;
 mod sfrbx;
 
+pub use crate::gnss::epoch_build::{preferred_signals, BuiltEpoch, EpochStats};
 pub use beidou_d1::{d1_subframe, decode_d1_ephemeris, D1Subframe};
 pub use bits::Bits;
-pub use epoch::{build_epoch, preferred_signals, BuiltEpoch, EpochStats};
+pub use epoch::build_epoch;
 pub use error::UbxError;
 pub use frame::{checksum, encode_frame, FrameReader, FrameStats, UbxFrame};
 pub use galileo_inav::{crc24q, decode_inav_ephemeris, inav_word, InavWord};

@@ -2,7 +2,7 @@
 //! built with the ephemerides decoded from the SFRBX messages received before it, as a
 //! real-time receiver would.
 
-use super::epoch::{build_epoch, BuiltEpoch};
+use super::epoch::build_epoch;
 use super::frame::{FrameReader, FrameStats};
 use super::message::{decode_message, UbxMessage};
 use super::nav_decoder::{NavDecoder, NavDecoderStats, NavUpdate};
@@ -10,6 +10,7 @@ use super::nav_pvt::NavPvt;
 use super::rawx::RawX;
 use super::sfrbx::Sfrbx;
 use crate::gnss::ephemeris::{EphemerisStore, GpsTime};
+use crate::gnss::epoch_build::BuiltEpoch;
 use crate::gnss::Klobuchar;
 
 /// SFRBX messages held while no RAWX has yet given the GPS week.

@@ -1,0 +1,356 @@
+//! `gnss_ins play`: publishes a recorded bag onto DDS with its original topic names and
+//! types, paced by the recorded log times, like `ros2 bag play`.
+//!
+//! The payloads are not decoded: each message's CDR body is re-published byte for byte,
+//! so any message type in the bag plays (not only the ones this package knows), and a
+//! subscriber receives exactly what was recorded.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use ros2_client::{
+    Context, ContextOptions, MessageTypeName, Name, Node, NodeName, NodeOptions, Publisher,
+    QosProfile,
+};
+use serde::ser::SerializeTuple;
+use serde::{Serialize, Serializer};
+
+use crate::ros::bag::{BagMessage, BagReader};
+use crate::ros::cdr::{CDR_LE, ENCAPSULATION_HEADER_LEN};
+use crate::ros::msg::{Clock, RosMessage, Time};
+
+/// Queue depth of the player's reliable publishers.
+///
+/// Choice: 1000 messages hold several seconds of a 150–200 Hz IMU, so a subscriber that
+/// stalls briefly still receives everything over reliable QoS.
+pub const PLAYER_QUEUE_DEPTH: usize = 1000;
+
+/// How long `--wait-for` waits for a subscriber before giving up.
+pub const WAIT_FOR_SUBSCRIBER_TIMEOUT: Duration = Duration::from_secs(30);
+
+/// How the bag is played.
+#[derive(Debug, Clone)]
+pub struct PlayOptions {
+    /// Speed factor: 2.0 plays twice as fast as recorded.
+    pub rate: f64,
+    /// Publish `/clock` (rosgraph_msgs/Clock) with the bag's time, for `use_sim_time`.
+    pub clock: bool,
+    /// Rate of `/clock` in bag time (Hz) when `clock` is set.
+    pub clock_hz: f64,
+    /// Play again from the start when the bag ends, until the process is stopped.
+    pub repeat: bool,
+    /// Wall time to wait after the publishers are created, before the first message.
+    pub delay: Duration,
+    /// Topics that must have a matched subscriber before playing starts.
+    pub wait_for_topics: Vec<String>,
+    /// DDS domain (`ROS_DOMAIN_ID`).
+    pub domain_id: u16,
+}
+
+/// What one pass over the bag did.
+#[derive(Debug, Default, Clone, PartialEq)]
+pub struct PlayReport {
+    /// Messages published, per topic.
+    pub published: BTreeMap<String, u64>,
+    /// Messages not published, with the reason.
+    pub skipped: BTreeMap<String, u64>,
+    /// Passes over the bag completed.
+    pub passes: u64,
+}
+
+/// Why playing failed.
+#[derive(Debug, thiserror::Error)]
+pub enum PlayError {
+    #[error("{0}")]
+    Bag(#[from] crate::ros::bag::BagError),
+    #[error("cannot create the DDS participant, node or publisher: {0}")]
+    Dds(String),
+    #[error("topic `{topic}` has type `{type_name}`, not a ROS 2 `package/msg/Name`")]
+    TypeName { topic: String, type_name: String },
+    #[error("invalid topic name `{0}`")]
+    TopicName(String),
+    #[error("--rate must be a positive number, got {0}")]
+    Rate(f64),
+    #[error("--clock-hz must be a positive number, got {0}")]
+    ClockRate(f64),
+    #[error("--wait-for {0}: the bag has no such topic")]
+    UnknownWaitTopic(String),
+    #[error("--wait-for {0}: no subscriber matched within {1:?}")]
+    NoSubscriber(String, Duration),
+}
+
+/// A CDR body re-published as it is: serializing writes the bytes with no length and
+/// no alignment, so the subscriber sees the recorded body unchanged.
+#[derive(Debug)]
+struct RawCdrBody(Vec<u8>);
+
+impl Serialize for RawCdrBody {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let mut tuple = serializer.serialize_tuple(self.0.len())?;
+        for byte in &self.0 {
+            tuple.serialize_element(byte)?;
+        }
+        tuple.end()
+    }
+}
+
+/// The little-endian CDR body of a recorded payload, or why it cannot be re-published
+/// as it is (DDS writers here emit little-endian CDR).
+fn little_endian_body(data: &[u8]) -> Result<&[u8], &'static str> {
+    match data.split_at_checked(ENCAPSULATION_HEADER_LEN) {
+        Some((header, body)) if header[..2] == CDR_LE => Ok(body),
+        Some(_) => Err("not little-endian CDR"),
+        None => Err("shorter than the CDR header"),
+    }
+}
+
+/// `package/msg/Name` → the DDS type name parts.
+fn message_type_name(type_name: &str) -> Option<MessageTypeName> {
+    let mut parts = type_name.split('/');
+    match (parts.next(), parts.next(), parts.next(), parts.next()) {
+        (Some(package), Some("msg"), Some(name), None)
+            if !package.is_empty() && !name.is_empty() =>
+        {
+            Some(MessageTypeName::new(package, name))
+        }
+        _ => None,
+    }
+}
+
+/// Wall-clock offset from the start of a pass at which a message recorded `since_start`
+/// after the bag's first message is released, at speed `rate`.
+pub fn release_offset(since_start: Duration, rate: f64) -> Duration {
+    since_start.div_f64(rate)
+}
+
+fn ros_time(log_time_ns: u64) -> Time {
+    Time {
+        sec: i32::try_from(log_time_ns / 1_000_000_000).unwrap_or(i32::MAX),
+        nanosec: (log_time_ns % 1_000_000_000) as u32,
+    }
+}
+
+fn dds_error(e: impl std::fmt::Debug) -> PlayError {
+    PlayError::Dds(format!("{e:?}"))
+}
+
+fn reliable_qos() -> QosProfile {
+    QosProfile::publisher_default().history(ros2_client::qos::History::KeepLast {
+        depth: PLAYER_QUEUE_DEPTH,
+    })
+}
+
+fn create_publisher<M: Serialize>(
+    node: &mut Node,
+    topic: &str,
+    type_name: MessageTypeName,
+) -> Result<Publisher<M>, PlayError> {
+    let name = Name::parse(topic).map_err(|_| PlayError::TopicName(topic.to_owned()))?;
+    let topic = node
+        .create_topic(&name, type_name, &reliable_qos())
+        .map_err(dds_error)?;
+    node.create_publisher::<M>(&topic, Some(reliable_qos()))
+        .map_err(dds_error)
+}
+
+/// Plays `bag` onto DDS; returns when the bag has played (never with `repeat`, unless
+/// the bag cannot be read).
+pub fn play(bag: &Path, options: &PlayOptions) -> Result<PlayReport, PlayError> {
+    if !(options.rate.is_finite() && options.rate > 0.0) {
+        return Err(PlayError::Rate(options.rate));
+    }
+    if options.clock && !(options.clock_hz.is_finite() && options.clock_hz > 0.0) {
+        return Err(PlayError::ClockRate(options.clock_hz));
+    }
+    let reader = BagReader::open(bag)?;
+    let context = Context::with_options(ContextOptions::new().domain_id(options.domain_id))
+        .map_err(dds_error)?;
+    let mut node = context
+        .new_node(
+            NodeName::new("/", "gnss_ins_player").map_err(dds_error)?,
+            NodeOptions::new()
+                .enable_rosout(false)
+                .start_parameter_services(false),
+        )
+        .map_err(dds_error)?;
+
+    let mut publishers = BTreeMap::new();
+    for info in reader.topics() {
+        let type_name = message_type_name(&info.type_name).ok_or_else(|| PlayError::TypeName {
+            topic: info.topic.clone(),
+            type_name: info.type_name.clone(),
+        })?;
+        let publisher = create_publisher::<RawCdrBody>(&mut node, &info.topic, type_name)?;
+        log::info!("playing {} ({})", info.topic, info.type_name);
+        publishers.insert(info.topic.clone(), publisher);
+    }
+    let clock = if options.clock {
+        let type_name = message_type_name(Clock::TYPE_NAME)
+            .ok_or_else(|| PlayError::Dds("bad Clock type name".to_owned()))?;
+        Some(create_publisher::<Clock>(&mut node, "/clock", type_name)?)
+    } else {
+        None
+    };
+
+    wait_for_subscribers(&mut node, &publishers, options)?;
+    std::thread::sleep(options.delay);
+
+    let mut report = PlayReport::default();
+    loop {
+        play_once(&reader, &publishers, clock.as_ref(), options, &mut report)?;
+        report.passes += 1;
+        if !options.repeat {
+            return Ok(report);
+        }
+    }
+}
+
+/// Waits until every `--wait-for` topic has a matched subscriber. The node's graph
+/// bookkeeping only advances while its spinner runs, so one runs meanwhile.
+fn wait_for_subscribers(
+    node: &mut Node,
+    publishers: &BTreeMap<String, Publisher<RawCdrBody>>,
+    options: &PlayOptions,
+) -> Result<(), PlayError> {
+    if options.wait_for_topics.is_empty() {
+        return Ok(());
+    }
+    let spinner = node.spinner().map_err(dds_error)?;
+    std::thread::spawn(move || smol::block_on(spinner.spin()));
+    for topic in &options.wait_for_topics {
+        let publisher = publishers
+            .get(topic)
+            .ok_or_else(|| PlayError::UnknownWaitTopic(topic.clone()))?;
+        let matched = smol::block_on(async {
+            let wait = futures::FutureExt::fuse(publisher.wait_for_subscription(node));
+            let timeout = futures::FutureExt::fuse(smol::Timer::after(WAIT_FOR_SUBSCRIBER_TIMEOUT));
+            futures::pin_mut!(wait, timeout);
+            futures::select! {
+                () = wait => true,
+                _ = timeout => false,
+            }
+        });
+        if !matched {
+            return Err(PlayError::NoSubscriber(
+                topic.clone(),
+                WAIT_FOR_SUBSCRIBER_TIMEOUT,
+            ));
+        }
+        log::info!("{topic}: subscriber matched");
+    }
+    Ok(())
+}
+
+fn count(map: &mut BTreeMap<String, u64>, key: &str) {
+    *map.entry(key.to_owned()).or_default() += 1;
+}
+
+/// One pass over the bag in log-time order (file order for a bag without an index).
+fn play_once(
+    reader: &BagReader,
+    publishers: &BTreeMap<String, Publisher<RawCdrBody>>,
+    clock: Option<&Publisher<Clock>>,
+    options: &PlayOptions,
+    report: &mut PlayReport,
+) -> Result<(), PlayError> {
+    let started = Instant::now();
+    let mut first_ns = None;
+    let mut last_clock_ns: Option<u64> = None;
+    let clock_period_ns = if options.clock {
+        (1e9 / options.clock_hz) as u64
+    } else {
+        u64::MAX
+    };
+    for message in reader.messages()? {
+        let BagMessage {
+            topic,
+            log_time_ns,
+            data,
+            ..
+        } = match message {
+            Ok(m) => m,
+            Err(e) => {
+                log::warn!(
+                    "{}: {e}; the rest of the bag is skipped",
+                    reader.path().display()
+                );
+                count(&mut report.skipped, "unreadable bag record");
+                break;
+            }
+        };
+        let first = *first_ns.get_or_insert(log_time_ns);
+        let since_start = Duration::from_nanos(log_time_ns.saturating_sub(first));
+        let due = started + release_offset(since_start, options.rate);
+        if let Some(wait) = due.checked_duration_since(Instant::now()) {
+            std::thread::sleep(wait);
+        }
+        if let Some(clock) = clock {
+            let clock_due = last_clock_ns
+                .is_none_or(|last| log_time_ns.saturating_sub(last) >= clock_period_ns);
+            if clock_due {
+                last_clock_ns = Some(log_time_ns);
+                let time = ros_time(log_time_ns);
+                if let Err(e) = clock.publish(Clock { clock: time }) {
+                    log::warn!("/clock: publish failed: {e:?}");
+                }
+            }
+        }
+        let Some(publisher) = publishers.get(&topic) else {
+            count(&mut report.skipped, "topic not in the bag's summary");
+            continue;
+        };
+        match little_endian_body(&data) {
+            Ok(body) => match publisher.publish(RawCdrBody(body.to_vec())) {
+                Ok(()) => count(&mut report.published, &topic),
+                Err(e) => {
+                    log::warn!("{topic}: publish failed: {e:?}");
+                    count(&mut report.skipped, "publish failed");
+                }
+            },
+            Err(reason) => {
+                log::warn!("{topic}: a payload is {reason}; skipped");
+                count(&mut report.skipped, reason);
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn raw_body_serializes_unchanged() {
+        let body = vec![1u8, 0, 0, 0, 0xAB, 0, 0, 0, 0, 0, 0xF0, 0x3F];
+        let encoded = crate::ros::cdr::encode(&RawCdrBody(body.clone())).unwrap();
+        assert_eq!(&encoded[ENCAPSULATION_HEADER_LEN..], &body[..]);
+    }
+
+    #[test]
+    fn payload_header_checks() {
+        assert_eq!(little_endian_body(&[0, 1, 0, 0, 7]), Ok(&[7u8][..]));
+        assert!(little_endian_body(&[0, 0, 0, 0, 7]).is_err());
+        assert!(little_endian_body(&[0, 1]).is_err());
+    }
+
+    #[test]
+    fn type_names() {
+        assert_eq!(
+            message_type_name("sensor_msgs/msg/Imu")
+                .unwrap()
+                .dds_msg_type(),
+            "sensor_msgs::msg::dds_::Imu_"
+        );
+        assert!(message_type_name("sensor_msgs/Imu").is_none());
+        assert!(message_type_name("a/srv/B").is_none());
+    }
+
+    #[test]
+    fn pacing_scales_with_rate() {
+        let t = Duration::from_secs(10);
+        assert_eq!(release_offset(t, 2.0), Duration::from_secs(5));
+        assert_eq!(release_offset(t, 0.5), Duration::from_secs(20));
+    }
+}

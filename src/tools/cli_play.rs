@@ -1,0 +1,60 @@
+//! `gnss_ins play`: a recorded bag published onto DDS (see [`crate::ros::player`]).
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use clap::Args;
+
+use crate::ros::node::domain_id_from;
+use crate::ros::player::{self, PlayOptions};
+
+#[derive(Args)]
+pub struct PlayArgs {
+    bag: PathBuf,
+    /// Speed factor (2 plays twice as fast as recorded).
+    #[arg(long, default_value_t = 1.0)]
+    rate: f64,
+    /// Publish /clock (rosgraph_msgs/Clock) with the bag's time, for use_sim_time.
+    #[arg(long)]
+    clock: bool,
+    /// Rate of /clock in bag time (Hz).
+    #[arg(long, default_value_t = 40.0)]
+    clock_hz: f64,
+    /// Play again from the start when the bag ends, until stopped.
+    #[arg(long = "loop")]
+    repeat: bool,
+    /// Seconds to wait after creating the publishers, before the first message.
+    #[arg(long, default_value_t = 0.0)]
+    delay: f64,
+    /// A topic that must have a matched subscriber before playing starts (repeatable).
+    #[arg(long = "wait-for")]
+    wait_for: Vec<String>,
+}
+
+pub fn play(args: PlayArgs) -> Result<(), String> {
+    let domain_id = domain_id_from(std::env::var("ROS_DOMAIN_ID").ok().as_deref())
+        .map_err(|e| e.to_string())?;
+    let delay = Duration::try_from_secs_f64(args.delay).map_err(|_| {
+        format!(
+            "--delay must be a non-negative number of seconds, got {}",
+            args.delay
+        )
+    })?;
+    let options = PlayOptions {
+        rate: args.rate,
+        clock: args.clock,
+        clock_hz: args.clock_hz,
+        repeat: args.repeat,
+        delay,
+        wait_for_topics: args.wait_for,
+        domain_id,
+    };
+    let report = player::play(&args.bag, &options).map_err(|e| e.to_string())?;
+    for (topic, n) in &report.published {
+        println!("{topic}: {n} published");
+    }
+    for (reason, n) in &report.skipped {
+        println!("skipped ({reason}): {n}");
+    }
+    Ok(())
+}

@@ -1,0 +1,312 @@
+//! The `gnss_ins` subcommands for real receiver data: `convert` (UBX log + IMU CSV +
+//! reference into a bag) and `spp` (our single-point solution over a bag or a UBX log).
+
+use std::path::PathBuf;
+
+use clap::{Args, ValueEnum};
+
+use super::cli::load_config;
+use super::convert::{
+    convert as convert_files, ConvertOptions, ConvertSummary, EphemerisMode, ImuInput, ImuTime,
+    TruthInput,
+};
+use super::imu_csv::{AccelUnit, GyroUnit, ImuCsvFormat};
+use super::replay::bag_inputs;
+use super::simulate::TRUTH_TOPIC;
+use super::spp_rinex::spp_rinex as solve_rinex_files;
+use super::spp_run::{run_spp, write_spp_csv};
+use super::time_scale::DEFAULT_GPS_UTC_LEAP_S;
+use crate::gnss::atmosphere::TroposphereModel;
+use crate::gnss::rinex_spp::{Ionosphere, RinexSppOptions};
+
+/// Unit of the accelerometer columns.
+#[derive(Clone, Copy, ValueEnum)]
+pub enum AccelUnitArg {
+    /// Standard gravities (9.80665 m/s²).
+    G,
+    /// m/s².
+    Mps2,
+}
+
+/// Unit of the gyro columns.
+#[derive(Clone, Copy, ValueEnum)]
+pub enum GyroUnitArg {
+    DegPerS,
+    RadPerS,
+}
+
+/// Which ephemerides give the satellite states.
+#[derive(Clone, Copy, ValueEnum)]
+pub enum EphemerisArg {
+    /// Every ephemeris decoded anywhere in the log (post-processing).
+    WholeLog,
+    /// Only those decoded before each epoch (real time).
+    AsReceived,
+}
+
+/// Arguments of `gnss_ins convert`.
+#[derive(Args)]
+pub struct ConvertArgs {
+    /// u-blox UBX log with UBX-RXM-RAWX and UBX-RXM-SFRBX (and UBX-NAV-PVT for
+    /// --truth-ubx). RAWX carries GPS time, so the log needs no time tag.
+    #[arg(long)]
+    pub ubx: PathBuf,
+    /// IMU CSV, one sample per line (see --imu-columns).
+    #[arg(long)]
+    pub imu_csv: Option<PathBuf>,
+    /// What each CSV column holds, comma-separated: ax ay az (accelerometer, specific
+    /// force), gx gy gz (gyro), one time column (tick_ms: the IMU's millisecond tick,
+    /// stamped with --imu-tag; gpst_s: GPST seconds since 1970), '-' to ignore a column.
+    #[arg(long, default_value = "ax,ay,az,gx,gy,gz,tick_ms")]
+    pub imu_columns: String,
+    #[arg(long, value_enum, default_value_t = AccelUnitArg::G)]
+    pub imu_accel_unit: AccelUnitArg,
+    #[arg(long, value_enum, default_value_t = GyroUnitArg::DegPerS)]
+    pub imu_gyro_unit: GyroUnitArg,
+    /// Rotation taking IMU-axis vectors into the FLU body frame: roll,pitch,yaw in degrees,
+    /// composed R = Rz(yaw)·Ry(pitch)·Rx(roll) (as mounting.imu_rotation_rpy_deg).
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true,
+          default_values_t = [0.0, 0.0, 0.0])]
+    pub imu_to_flu_rpy_deg: Vec<f64>,
+    /// RTKLIB time-tag file of the IMU CSV (for a tick_ms column): a sample's GPST is the
+    /// tag's start + (tick − first tick)/1000, stretched so that the last sample lands on
+    /// the tag's last record.
+    #[arg(long)]
+    pub imu_tag: Option<PathBuf>,
+    /// Reference from the log's UBX-NAV-PVT solutions (e.g. a receiver running RTK).
+    #[arg(long, conflicts_with = "truth_pos")]
+    pub truth_ubx: bool,
+    /// Reference from an RTKLIB .pos file (GPST).
+    #[arg(long)]
+    pub truth_pos: Option<PathBuf>,
+    /// Geoid separation (m) added to the .pos heights (0 when they are ellipsoidal; the
+    /// receiver's NAV-PVT height − hMSL when they are above mean sea level).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub geoid_separation_m: f64,
+    /// GPS − UTC leap seconds: ROS stamps are GPST − this.
+    #[arg(long, default_value_t = DEFAULT_GPS_UTC_LEAP_S)]
+    pub leap_seconds: f64,
+    #[arg(long, value_enum, default_value_t = EphemerisArg::WholeLog)]
+    pub ephemeris: EphemerisArg,
+    /// Output bag.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+impl ConvertArgs {
+    /// The conversion these arguments ask for.
+    pub fn options(&self) -> Result<ConvertOptions, String> {
+        let imu = match &self.imu_csv {
+            None => None,
+            Some(csv) => {
+                let [r, p, y] = <[f64; 3]>::try_from(self.imu_to_flu_rpy_deg.as_slice())
+                    .map_err(|_| "--imu-to-flu-rpy-deg needs three angles".to_owned())?;
+                let format = ImuCsvFormat::new(
+                    &self.imu_columns,
+                    match self.imu_accel_unit {
+                        AccelUnitArg::G => AccelUnit::G,
+                        AccelUnitArg::Mps2 => AccelUnit::MetresPerSecond2,
+                    },
+                    match self.imu_gyro_unit {
+                        GyroUnitArg::DegPerS => GyroUnit::DegPerS,
+                        GyroUnitArg::RadPerS => GyroUnit::RadPerS,
+                    },
+                    [r, p, y],
+                )
+                .map_err(|e| e.to_string())?;
+                let ticks = self.imu_columns.split(',').any(|c| c.trim() == "tick_ms");
+                let time = match (&self.imu_tag, ticks) {
+                    (Some(tag), true) => ImuTime::Tag(tag.clone()),
+                    (None, false) => ImuTime::Column,
+                    (None, true) => {
+                        return Err("a tick_ms IMU column needs --imu-tag".to_owned());
+                    }
+                    (Some(_), false) => {
+                        return Err("--imu-tag needs a tick_ms IMU column".to_owned());
+                    }
+                };
+                Some(ImuInput {
+                    csv: csv.clone(),
+                    format,
+                    time,
+                })
+            }
+        };
+        let truth = match (&self.truth_pos, self.truth_ubx) {
+            (Some(path), _) => TruthInput::Pos {
+                path: path.clone(),
+                geoid_separation_m: self.geoid_separation_m,
+            },
+            (None, true) => TruthInput::UbxNavPvt,
+            (None, false) => TruthInput::None,
+        };
+        Ok(ConvertOptions {
+            ubx: self.ubx.clone(),
+            imu,
+            truth,
+            leap_seconds: self.leap_seconds,
+            ephemeris: match self.ephemeris {
+                EphemerisArg::WholeLog => EphemerisMode::WholeLog,
+                EphemerisArg::AsReceived => EphemerisMode::AsReceived,
+            },
+        })
+    }
+}
+
+/// Arguments of `gnss_ins spp`.
+#[derive(Args)]
+pub struct SppArgs {
+    /// A bag with GNSS measurements (and a reference on /ground_truth), or a UBX log
+    /// (name ending in .ubx), converted on the fly.
+    pub input: PathBuf,
+    /// Parameter file whose gnss.* settings (mask, σ model, constellations) are used.
+    #[arg(long)]
+    pub params: Option<PathBuf>,
+    /// With a UBX log: reference from its UBX-NAV-PVT solutions.
+    #[arg(long, conflicts_with = "truth_pos")]
+    pub truth_ubx: bool,
+    /// With a UBX log: reference from an RTKLIB .pos file (GPST).
+    #[arg(long)]
+    pub truth_pos: Option<PathBuf>,
+    /// With --truth-pos: geoid separation (m) added to its heights.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub geoid_separation_m: f64,
+    /// With a UBX log: GPS − UTC leap seconds.
+    #[arg(long, default_value_t = DEFAULT_GPS_UTC_LEAP_S)]
+    pub leap_seconds: f64,
+    /// Output CSV of the solutions.
+    #[arg(long)]
+    pub csv: Option<PathBuf>,
+}
+
+fn print_convert_summary(out: &std::path::Path, s: &ConvertSummary) {
+    eprintln!(
+        "wrote {}: {} GNSS epochs ({:.1} satellites each; {} epochs without a usable \
+         satellite left out; Klobuchar {}), {} IMU samples, reference {:?}; UTC {:.3}..{:.3} s",
+        out.display(),
+        s.gnss_epochs,
+        s.satellites as f64 / s.gnss_epochs.max(1) as f64,
+        s.empty_epochs,
+        if s.klobuchar { "present" } else { "absent" },
+        s.imu_samples,
+        s.truth,
+        s.span_utc_s.0,
+        s.span_utc_s.1
+    );
+    for (reason, n) in &s.imu_skipped {
+        eprintln!("skipped {n} IMU lines: {reason}");
+    }
+    for (reason, n) in &s.truth_skipped {
+        eprintln!("skipped {n} reference lines: {reason}");
+    }
+}
+
+/// `gnss_ins convert`.
+pub fn convert(args: ConvertArgs) -> Result<(), String> {
+    let options = args.options()?;
+    let summary = convert_files(&options, &args.out).map_err(|e| e.to_string())?;
+    print_convert_summary(&args.out, &summary);
+    if let Some(leap) = summary.receiver_leap_seconds {
+        if f64::from(leap) != options.leap_seconds {
+            eprintln!(
+                "warning: the receiver reports GPS - UTC = {leap} s, --leap-seconds is {} s",
+                options.leap_seconds
+            );
+        }
+    }
+    Ok(())
+}
+
+/// `gnss_ins spp`.
+pub fn spp(args: SppArgs) -> Result<(), String> {
+    let config = load_config(args.params.as_deref())?;
+    let is_ubx = args
+        .input
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("ubx"));
+    let temp = std::env::temp_dir().join(format!("gnss_ins_spp_{}.mcap", std::process::id()));
+    let bag = if is_ubx {
+        let convert = ConvertArgs {
+            ubx: args.input.clone(),
+            imu_csv: None,
+            imu_columns: String::new(),
+            imu_accel_unit: AccelUnitArg::G,
+            imu_gyro_unit: GyroUnitArg::DegPerS,
+            imu_to_flu_rpy_deg: vec![0.0; 3],
+            imu_tag: None,
+            truth_ubx: args.truth_ubx,
+            truth_pos: args.truth_pos.clone(),
+            geoid_separation_m: args.geoid_separation_m,
+            leap_seconds: args.leap_seconds,
+            ephemeris: EphemerisArg::WholeLog,
+            out: temp.clone(),
+        };
+        convert_files(&convert.options()?, &temp).map_err(|e| e.to_string())?;
+        temp.clone()
+    } else {
+        args.input.clone()
+    };
+    let inputs = bag_inputs(&bag, Some(TRUTH_TOPIC.to_owned())).map_err(|e| e.to_string());
+    let report = inputs.map(|inputs| run_spp(inputs, &config));
+    if is_ubx {
+        // Best effort: a temporary file left behind is harmless.
+        let _ = std::fs::remove_file(&temp);
+    }
+    let report = report?;
+    if let Some(path) = &args.csv {
+        write_spp_csv(path, &report).map_err(|e| format!("{}: {e}", path.display()))?;
+    }
+    println!(
+        "{} epochs solved, {} not",
+        report.rows.len(),
+        report.failures.values().sum::<usize>()
+    );
+    for (reason, n) in &report.failures {
+        println!("  {n} epochs: {reason}");
+    }
+    println!(
+        "{:<14} {:>7} {:>8} {:>8} {:>8}",
+        "reference", "epochs", "horiz_m", "vert_m", "pos3d_m"
+    );
+    for (label, s) in report.summary_by_label() {
+        println!(
+            "{:<14} {:>7} {:>8.3} {:>8.3} {:>8.3}",
+            label, s.epochs, s.pos_rmse_horizontal_m, s.pos_rmse_u_m, s.pos_rmse_3d_m
+        );
+    }
+    Ok(())
+}
+
+/// `gnss_ins spp-rinex`: RINEX 3 observation and navigation files.
+#[derive(Args)]
+pub struct SppRinexArgs {
+    /// RINEX 3 observation file.
+    obs: PathBuf,
+    /// RINEX 3 navigation file.
+    nav: PathBuf,
+    /// Output CSV, one line per epoch.
+    #[arg(long)]
+    out_csv: PathBuf,
+    /// Neither ionospheric nor tropospheric delays (rnx2rtkp's command-line default).
+    #[arg(long)]
+    no_atmosphere: bool,
+}
+
+pub fn spp_rinex(args: SppRinexArgs) -> Result<(), String> {
+    let options = if args.no_atmosphere {
+        RinexSppOptions::rtklib_single(Ionosphere::Off, TroposphereModel::Off)
+    } else {
+        RinexSppOptions::rtklib_single_brdc_saas()
+    };
+    let s = solve_rinex_files(&args.obs, &args.nav, &args.out_csv, &options)
+        .map_err(|e| e.to_string())?;
+    eprintln!(
+        "wrote {}: {} of {} epochs solved ({} malformed lines, {} event records skipped)",
+        args.out_csv.display(),
+        s.solved,
+        s.epochs,
+        s.malformed_lines,
+        s.skipped_records
+    );
+    Ok(())
+}

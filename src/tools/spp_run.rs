@@ -1,0 +1,162 @@
+//! `gnss_ins spp`: our single-point solution of every epoch of a stream of session inputs
+//! (a bag's GNSS measurements and its reference), scored against the reference, for
+//! checking the measurement pipeline without the filter.
+//!
+//! Scoring: the reference is interpolated to the epoch's time ([`TruthTrack`]) and the
+//! epoch takes the label (environment) of the reference sample nearest in time.
+
+use std::collections::BTreeMap;
+use std::io::Write;
+use std::path::Path;
+
+use crate::config::Config;
+use crate::earth::{self, Llh};
+use crate::engine::tight_update::sigma_model;
+use crate::eval::{self, ErrorSummary, SolutionError, TruthSample, TruthTrack};
+use crate::gnss::spp::{solve_spp, SppConfig};
+use crate::gnss::GnssEpoch;
+
+use super::session::SessionInput;
+
+/// Reference samples further apart than this are not interpolated across (s).
+const MAX_TRUTH_GAP_S: f64 = 1.0;
+
+/// The solution of one epoch.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SppRow {
+    pub t_s: f64,
+    pub position: Llh,
+    pub clock_bias_m: f64,
+    pub satellites_used: usize,
+    /// Error against the reference (ENU, m) and the reference's label, when scored.
+    pub error: Option<(nalgebra::Vector3<f64>, String)>,
+}
+
+/// The result of a run.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SppReport {
+    pub rows: Vec<SppRow>,
+    /// Epochs without a solution, by reason.
+    pub failures: BTreeMap<String, usize>,
+}
+
+impl SppReport {
+    /// Error summaries by label, and over every scored epoch under "all".
+    pub fn summary_by_label(&self) -> BTreeMap<String, ErrorSummary> {
+        let mut by: BTreeMap<String, Vec<SolutionError>> = BTreeMap::new();
+        for row in &self.rows {
+            if let Some((e, label)) = &row.error {
+                let err = SolutionError {
+                    t_s: row.t_s,
+                    position_enu_m: *e,
+                    velocity_enu_mps: None,
+                    attitude_rpy_rad: None,
+                    nees: f64::NAN,
+                    nees_dof: 3,
+                };
+                by.entry(label.clone()).or_default().push(err);
+                by.entry("all".to_owned()).or_default().push(err);
+            }
+        }
+        by.into_iter()
+            .map(|(k, v)| (k, eval::summarize(&v)))
+            .collect()
+    }
+}
+
+/// The single-point settings of a filter configuration: its elevation mask and σ model.
+pub fn spp_config(config: &Config) -> SppConfig {
+    SppConfig {
+        elevation_mask_rad: config.gnss.elevation_mask_rad,
+        sigma: sigma_model(config),
+        ..SppConfig::default()
+    }
+}
+
+/// Solves every GNSS epoch of `inputs` with the constellations and settings of `config`
+/// and scores the solutions against the reference samples of `inputs`.
+pub fn run_spp(inputs: impl Iterator<Item = SessionInput>, config: &Config) -> SppReport {
+    let settings = spp_config(config);
+    let mut epochs: Vec<GnssEpoch> = Vec::new();
+    let mut truth: Vec<TruthSample> = Vec::new();
+    let mut labels: Vec<(f64, String)> = Vec::new();
+    let mut environment = "unlabelled".to_owned();
+    for input in inputs {
+        match input {
+            SessionInput::Gnss(e) => epochs.push(e),
+            SessionInput::Truth(t) => {
+                labels.push((t.t_s, environment.clone()));
+                truth.push(t);
+            }
+            SessionInput::Environment { name, .. } => environment = name,
+            _ => {}
+        }
+    }
+    let track = TruthTrack::new(truth, MAX_TRUTH_GAP_S);
+    let mut report = SppReport::default();
+    for mut epoch in epochs {
+        epoch
+            .satellites
+            .retain(|s| config.gnss.constellations.contains(&s.sat.constellation));
+        match solve_spp(&epoch, &settings) {
+            Err(e) => *report.failures.entry(e.to_string()).or_insert(0) += 1,
+            Ok(sol) => {
+                let error = track.at(epoch.t_s).map(|reference| {
+                    (
+                        earth::llh_to_enu(&sol.pos_llh, &reference.p),
+                        nearest_label(&labels, epoch.t_s),
+                    )
+                });
+                report.rows.push(SppRow {
+                    t_s: epoch.t_s,
+                    position: sol.pos_llh,
+                    clock_bias_m: sol.clock_bias_m,
+                    satellites_used: sol.num_used,
+                    error,
+                });
+            }
+        }
+    }
+    report
+}
+
+fn nearest_label(labels: &[(f64, String)], t_s: f64) -> String {
+    let i = labels.partition_point(|(t, _)| *t <= t_s);
+    let candidates = [i.checked_sub(1), Some(i)];
+    candidates
+        .into_iter()
+        .flatten()
+        .filter_map(|k| labels.get(k))
+        .min_by(|a, b| (a.0 - t_s).abs().total_cmp(&(b.0 - t_s).abs()))
+        .map_or_else(|| "unlabelled".to_owned(), |(_, l)| l.clone())
+}
+
+/// Writes the solutions as CSV: time (s, the bag's stamps), latitude and longitude (deg),
+/// ellipsoidal height (m), clock bias (m), satellites used, then the ENU error (m) and the
+/// reference label when scored (empty otherwise).
+pub fn write_spp_csv(path: &Path, report: &SppReport) -> std::io::Result<()> {
+    let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);
+    writeln!(
+        w,
+        "t_s,lat_deg,lon_deg,height_m,clock_bias_m,satellites_used,err_e_m,err_n_m,err_u_m,reference"
+    )?;
+    for r in &report.rows {
+        let (e, label) = match &r.error {
+            Some((e, l)) => (format!("{},{},{}", e[0], e[1], e[2]), l.as_str()),
+            None => (",,".to_owned(), ""),
+        };
+        writeln!(
+            w,
+            "{},{},{},{},{},{},{},{}",
+            r.t_s,
+            r.position.lat_rad.to_degrees(),
+            r.position.lon_rad.to_degrees(),
+            r.position.height_m,
+            r.clock_bias_m,
+            r.satellites_used,
+            e,
+            label
+        )?;
+    }
+    w.flush()
+}

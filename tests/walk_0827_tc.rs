@@ -1,0 +1,263 @@
+//! The real recording walk_0827 (../shared/data/walk_0827) converted in-process by the
+//! `gnss_ins convert` code and run through the tightly-coupled EKF on the engine path of
+//! `gnss_ins compare`, against the receiver's RTK solution (its fixed epochs).
+
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use adaptive_gnss_ins::config::Config;
+use adaptive_gnss_ins::eval::ErrorSummary;
+use adaptive_gnss_ins::tools::convert::{
+    convert, ConvertOptions, EphemerisMode, ImuInput, ImuTime, TruthInput,
+};
+use adaptive_gnss_ins::tools::imu_csv::{AccelUnit, GyroUnit, ImuCsvFormat};
+use adaptive_gnss_ins::tools::replay::bag_inputs;
+use adaptive_gnss_ins::tools::session::{Session, SessionInput};
+use adaptive_gnss_ins::tools::simulate::TRUTH_TOPIC;
+use adaptive_gnss_ins::tools::spp_run::run_spp;
+use adaptive_gnss_ins::tools::time_scale::DEFAULT_GPS_UTC_LEAP_S;
+
+/// The data set README: NAV-PVT height − hMSL.
+const GEOID_SEPARATION_M: f64 = -21.387;
+
+/// The IMU axes in the FLU body: x left, y backward, z up, i.e. R = Rz(+90°).
+///
+/// The README gives the mounting as roll, pitch, yaw = 180°, 0°, −90° against a
+/// forward-right-down body without the convention. Found from the data
+/// (`imu_axes_are_confirmed_by_gravity_turns_and_travel` checks it on every run):
+/// - at rest the accelerometers read +1.01 g on z: z is up for a specific force;
+/// - the z gyro turns with the reference's course, counter-clockwise positive: z is up
+///   in a right-handed frame (so the accelerometers do report specific force);
+/// - in turns the centripetal acceleration (speed × yaw rate, towards the inside) shows
+///   on IMU x with a positive sign: x points left, so y points backward.
+///
+/// That is the README's angles composed R_imu→FRD = Rz(−90°)·Rx(180°) (yaw after roll,
+/// the order of `mounting.imu_rotation_rpy_deg`); FRD → FLU (Rx(180°)) then gives
+/// Rz(+90°). The other order, Rx(180°)·Rz(−90°), would put x to the right: refuted.
+const IMU_TO_FLU_RPY_DEG: [f64; 3] = [0.0, 0.0, 90.0];
+
+/// Horizontal RMSE budget of the tightly-coupled EKF (params/walk_0827.yaml) against the
+/// RTK-fixed epochs (m). Measured 8.905 m on 291 fixed epochs when this was set (README,
+/// "Real data: walk_0827"); the budget is that plus about 7 %.
+///
+/// Not asserted: that the EKF beats our single-point solution on the same epochs. It does
+/// not (SPP 8.600 m): both are held by a bias common to every epoch, not by noise. The
+/// single-point errors average (5.8 E, 6.1 N, 11.2 U) m with a spread of only
+/// (0.7, 0.9, 2.1) m: the ionosphere, which nothing corrects here (the 134 s log holds no
+/// GPS Klobuchar page, and the BeiDou and Galileo ionosphere models are not implemented).
+/// Filtering removes noise, not a bias the model lacks.
+const TC_EKF_FIXED_HORIZONTAL_BUDGET_M: f64 = 9.5;
+
+fn data() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/walk_0827")
+}
+
+/// The conversion `gnss_ins convert` does with the README's command line.
+fn options() -> ConvertOptions {
+    let d = data();
+    ConvertOptions {
+        ubx: d.join("gnss_1730.ubx"),
+        imu: Some(ImuInput {
+            csv: d.join("imu_1730.csv"),
+            format: ImuCsvFormat::new(
+                "ax,ay,az,gx,gy,gz,tick_ms",
+                AccelUnit::G,
+                GyroUnit::DegPerS,
+                IMU_TO_FLU_RPY_DEG,
+            )
+            .unwrap(),
+            time: ImuTime::Tag(d.join("imu_1730.csv.tag")),
+        }),
+        truth: TruthInput::Pos {
+            path: d.join("gnss_1730_sf.pos"),
+            geoid_separation_m: GEOID_SEPARATION_M,
+        },
+        leap_seconds: DEFAULT_GPS_UTC_LEAP_S,
+        ephemeris: EphemerisMode::WholeLog,
+    }
+}
+
+/// The converted bag, made once per test binary in Cargo's scratch folder.
+fn bag() -> &'static Path {
+    static BAG: OnceLock<PathBuf> = OnceLock::new();
+    BAG.get_or_init(|| {
+        let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("walk_0827_tc.mcap");
+        let summary = convert(&options(), &out).unwrap_or_else(|e| {
+            panic!("converting walk_0827 (../shared/data/walk_0827 beside the crate): {e}")
+        });
+        println!("{summary:?}");
+        assert_eq!(summary.gnss_epochs, 536);
+        assert_eq!(summary.imu_samples, 20_455);
+        assert_eq!(
+            summary.truth,
+            vec![("rtk_fixed".to_owned(), 349), ("rtk_float".to_owned(), 187)]
+        );
+        out
+    })
+}
+
+fn inputs() -> Vec<SessionInput> {
+    bag_inputs(bag(), Some(TRUTH_TOPIC.to_owned()))
+        .unwrap()
+        .collect()
+}
+
+fn correlation(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len() as f64;
+    let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
+    let cov: f64 = a.iter().zip(b).map(|(x, y)| (x - ma) * (y - mb)).sum();
+    let va: f64 = a.iter().map(|x| (x - ma).powi(2)).sum();
+    let vb: f64 = b.iter().map(|y| (y - mb).powi(2)).sum();
+    cov / (va * vb).sqrt()
+}
+
+#[test]
+fn imu_axes_are_confirmed_by_gravity_turns_and_travel() {
+    let inputs = inputs();
+    let imu: Vec<_> = inputs
+        .iter()
+        .filter_map(|i| match i {
+            SessionInput::Imu(s) => Some(*s),
+            _ => None,
+        })
+        .collect();
+    let truth: Vec<_> = inputs
+        .iter()
+        .filter_map(|i| match i {
+            SessionInput::Truth(t) => Some(*t),
+            _ => None,
+        })
+        .collect();
+    // Gravity: the mean specific force over the first 5 s (at rest) points up.
+    let t0 = imu[0].t_s;
+    let rest: Vec<_> = imu.iter().filter(|s| s.t_s < t0 + 5.0).collect();
+    let f = rest
+        .iter()
+        .map(|s| s.f_ib_b_m_s2)
+        .sum::<nalgebra::Vector3<f64>>()
+        / rest.len() as f64;
+    println!("mean specific force at rest (FLU): {:?}", f.as_slice());
+    assert!(f[2] > 9.6 && f[2] < 10.1, "{f:?}");
+    assert!(f[0].hypot(f[1]) < 0.5, "{f:?}");
+    // Turns: at each reference sample while walking, the IMU averaged over ±0.125 s
+    // against the reference's course rate (counter-clockwise) and centripetal acceleration.
+    let (mut gyro_z, mut course_rate, mut f_left, mut f_fwd, mut centripetal) =
+        (vec![], vec![], vec![], vec![], vec![]);
+    for w in truth.windows(3) {
+        let (a, b, c) = (&w[0], &w[1], &w[2]);
+        let (Some(va), Some(vb), Some(vc)) = (a.v_n, b.v_n, c.v_n) else {
+            continue;
+        };
+        let speed = vb[0].hypot(vb[1]);
+        if speed < 0.5 || va[0].hypot(va[1]) < 0.5 || vc[0].hypot(vc[1]) < 0.5 {
+            continue;
+        }
+        let course = |v: &nalgebra::Vector3<f64>| v[1].atan2(v[0]);
+        let mut d = course(&vc) - course(&va);
+        d = (d + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI)
+            - std::f64::consts::PI;
+        let rate = d / (c.t_s - a.t_s);
+        let near: Vec<_> = imu
+            .iter()
+            .filter(|s| (s.t_s - b.t_s).abs() <= 0.125)
+            .collect();
+        if near.is_empty() {
+            continue;
+        }
+        let n = near.len() as f64;
+        let mean_w = near
+            .iter()
+            .map(|s| s.w_ib_b_rad_s)
+            .sum::<nalgebra::Vector3<f64>>()
+            / n;
+        let mean_f = near
+            .iter()
+            .map(|s| s.f_ib_b_m_s2)
+            .sum::<nalgebra::Vector3<f64>>()
+            / n;
+        gyro_z.push(mean_w[2]);
+        course_rate.push(rate);
+        f_left.push(mean_f[1]);
+        f_fwd.push(mean_f[0]);
+        centripetal.push(speed * rate);
+    }
+    let yaw = correlation(&gyro_z, &course_rate);
+    let left = correlation(&f_left, &centripetal);
+    let forward = correlation(&f_fwd, &centripetal);
+    println!(
+        "{} walking samples: corr(gyro z, course rate) {yaw:.3}, corr(f left, v·rate) \
+         {left:.3}, corr(f forward, v·rate) {forward:.3}",
+        gyro_z.len()
+    );
+    assert!(gyro_z.len() > 300);
+    assert!(yaw > 0.6, "z gyro against the course rate: {yaw}");
+    assert!(
+        left > 0.5,
+        "left axis against the centripetal acceleration: {left}"
+    );
+    assert!(
+        forward.abs() < 0.3,
+        "forward axis against the centripetal: {forward}"
+    );
+}
+
+fn config() -> Config {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("params/walk_0827.yaml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    Config::from_yaml_str(&text, "walk_0827.yaml").unwrap()
+}
+
+fn summary(by: &std::collections::BTreeMap<String, ErrorSummary>, key: &str) -> ErrorSummary {
+    *by.get(key)
+        .unwrap_or_else(|| panic!("no {key} epochs scored: {:?}", by.keys()))
+}
+
+#[test]
+fn tightly_coupled_ekf_stays_within_budget() {
+    let config = config();
+    let mut session = Session::new(config.clone(), 0.0, None);
+    for input in inputs() {
+        session.push(input);
+    }
+    let report = session.finish();
+    let by = report.summary_by_environment(f64::NEG_INFINITY);
+    let fixed = summary(&by, "rtk_fixed");
+    let first_scored_t_s = report
+        .errors
+        .iter()
+        .map(|(_, e)| e.t_s)
+        .fold(f64::INFINITY, f64::min);
+    // Our single-point solution on the same measurements and the same epochs (those
+    // after the filter started), for the record (see the budget's note).
+    let spp = run_spp(
+        inputs().into_iter().filter(|i| match i {
+            SessionInput::Gnss(e) => e.t_s >= first_scored_t_s,
+            _ => true,
+        }),
+        &config,
+    );
+    let spp_fixed = summary(&spp.summary_by_label(), "rtk_fixed");
+    println!(
+        "EKF on {} fixed epochs: horizontal {:.3} m, vertical {:.3} m; SPP on {}: \
+         horizontal {:.3} m, vertical {:.3} m; rejected inputs {}",
+        fixed.epochs,
+        fixed.pos_rmse_horizontal_m,
+        fixed.pos_rmse_u_m,
+        spp_fixed.epochs,
+        spp_fixed.pos_rmse_horizontal_m,
+        spp_fixed.pos_rmse_u_m,
+        report.rejected.len()
+    );
+    assert!(fixed.epochs > 250, "{} fixed epochs scored", fixed.epochs);
+    assert!(
+        spp_fixed.epochs > 250,
+        "{} SPP epochs scored",
+        spp_fixed.epochs
+    );
+    assert!(
+        fixed.pos_rmse_horizontal_m < TC_EKF_FIXED_HORIZONTAL_BUDGET_M,
+        "horizontal RMSE {} m over the budget {} m",
+        fixed.pos_rmse_horizontal_m,
+        TC_EKF_FIXED_HORIZONTAL_BUDGET_M
+    );
+}
