@@ -1,6 +1,7 @@
 //! `gnss_ins play` over DDS: a subscriber in this process receives every Imu and
 //! GnssMeasurements message of the fixture bag, unchanged and in order, and /clock
-//! follows the bag's time.
+//! follows the bag's time; and the bag played into `gnss_ins_node --record` gives the
+//! Odometry that `gnss_ins replay` computes from the same bag.
 //!
 //! DDS traffic stays on this machine: the test re-executes itself inside a private
 //! network namespace that has only loopback (`unshare -n`, needs root).
@@ -9,9 +10,11 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
+use adaptive_gnss_ins::config::Config;
 use adaptive_gnss_ins::ros::bag::BagReader;
 use adaptive_gnss_ins::ros::cdr;
-use adaptive_gnss_ins::ros::msg::{Clock, GnssMeasurements, Imu, RosMessage};
+use adaptive_gnss_ins::ros::msg::{Clock, GnssMeasurements, Imu, Odometry, RosMessage};
+use adaptive_gnss_ins::tools::replay::{replay, ReplayOptions, TruthSource};
 use ros2_client::{
     Context, ContextOptions, MessageTypeName, Name, Node, NodeName, NodeOptions, QosProfile,
     Subscription,
@@ -164,4 +167,126 @@ fn play_publishes_the_bag_unchanged() {
         (c0 - bag_start).abs() < 1.0 && (c1 - bag_end).abs() < 1.0,
         "/clock spans {c0}..{c1}, the bag's IMU {bag_start}..{bag_end}"
     );
+}
+
+/// The Odometry messages of a bag, in order.
+fn odometry_of(bag: &Path, topic: &str) -> Vec<Odometry> {
+    BagReader::open(bag)
+        .unwrap()
+        .messages()
+        .unwrap()
+        .map(Result::unwrap)
+        .filter(|m| m.topic == topic)
+        .map(|m| cdr::decode::<Odometry>(&m.data).unwrap())
+        .collect()
+}
+
+/// Largest difference between two solutions' positions, velocities and orientations.
+fn largest_difference(a: &Odometry, b: &Odometry) -> f64 {
+    let (pa, pb) = (&a.pose.pose.position, &b.pose.pose.position);
+    let (va, vb) = (&a.twist.twist.linear, &b.twist.twist.linear);
+    let (qa, qb) = (&a.pose.pose.orientation, &b.pose.pose.orientation);
+    [
+        pa.x - pb.x,
+        pa.y - pb.y,
+        pa.z - pb.z,
+        va.x - vb.x,
+        va.y - vb.y,
+        va.z - vb.z,
+        qa.x - qb.x,
+        qa.y - qb.y,
+        qa.z - qb.z,
+        qa.w - qb.w,
+    ]
+    .iter()
+    .fold(0.0_f64, |m, d| m.max(d.abs()))
+}
+
+#[test]
+fn node_records_the_replay_solution_of_a_played_bag() {
+    if reexec_in_private_netns("node_records_the_replay_solution_of_a_played_bag") {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let recorded = dir.path().join("node.mcap");
+    let replayed = dir.path().join("replay.mcap");
+    let domain = (DOMAIN_ID + 1).to_string();
+    let node = Command::new(env!("CARGO_BIN_EXE_gnss_ins_node"))
+        .arg("--record")
+        .arg(&recorded)
+        .args(["--ros-args", "-r", "__node:=recorder_test"])
+        .env("ROS_DOMAIN_ID", &domain)
+        .env("RUST_LOG", "info,rustdds=error,ros2_client=warn")
+        .spawn()
+        .unwrap();
+    let status = Command::new(env!("CARGO_BIN_EXE_gnss_ins"))
+        .arg("play")
+        .arg(fixture())
+        .args(["--rate", "2"])
+        .args(["--wait-for", "/imu", "--wait-for", "/gnss/measurements"])
+        .env("ROS_DOMAIN_ID", &domain)
+        .env("RUST_LOG", "warn,rustdds=error")
+        .stdout(Stdio::null())
+        .status()
+        .unwrap();
+    assert!(status.success(), "gnss_ins play failed: {status}");
+    std::thread::sleep(Duration::from_secs(1));
+    // SIGINT, as Ctrl-C: the node completes the bag and exits cleanly.
+    let kill = Command::new("kill")
+        .args(["-INT", &node.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let mut node = node;
+    let exit = node.wait().unwrap();
+    assert!(exit.success(), "the node did not stop cleanly: {exit}");
+
+    let topics: Vec<String> = BagReader::open(&recorded)
+        .unwrap()
+        .topics()
+        .iter()
+        .map(|t| t.topic.clone())
+        .collect();
+    for want in [
+        "/odometry",
+        "/fix",
+        "/gnss_ins_node/noise_estimates",
+        "/diagnostics",
+    ] {
+        let want = want.replace("gnss_ins_node", "recorder_test");
+        assert!(topics.contains(&want), "{want} not recorded: {topics:?}");
+    }
+
+    replay(
+        &fixture(),
+        &Config::default(),
+        TruthSource::None,
+        &ReplayOptions {
+            out_bag: Some(&replayed),
+            csv: None,
+            score_interval_s: 0.0,
+        },
+        |_| {},
+    )
+    .unwrap();
+    let live = odometry_of(&recorded, "/odometry");
+    let offline = odometry_of(&replayed, "/odometry");
+    assert_eq!(
+        live.len(),
+        offline.len(),
+        "Odometry messages: node vs replay"
+    );
+    let worst = live
+        .iter()
+        .zip(&offline)
+        .map(|(a, b)| {
+            assert_eq!(a.header.stamp, b.header.stamp);
+            largest_difference(a, b)
+        })
+        .fold(0.0_f64, f64::max);
+    println!(
+        "node vs replay: {} solutions, largest difference {worst:e}",
+        live.len()
+    );
+    assert!(worst <= 1e-9, "node and replay differ by {worst}");
 }

@@ -47,8 +47,6 @@ ROUNDING = 1e-9
 # The fixture's IMU rate, and every how many IMU samples the bag time goes on /clock.
 BAG_IMU_RATE_HZ = 100.0
 CLOCK_EVERY_IMU = 10
-# Wall time left between the last sample on one topic and the first on the other.
-TOPIC_SWITCH_GAP_S = 0.02
 # Odometry position error allowed, in multiples of the filter's own 3D sigma
 # (sqrt of the trace of its position covariance).
 SIGMA_BUDGET = 3.0
@@ -216,19 +214,15 @@ def handshake(peer, checks):
 def stream(peer, inputs, speed, clock_every):
     """Publishes the inputs paced at `speed` times real time; returns counts per topic.
 
-    DDS orders the samples of one writer only: when the topic changes, the previous
-    sample is given TOPIC_SWITCH_GAP_S to be processed first, so that the node sees the
-    bag's order (the engine's start-up depends on it) as `gnss_ins replay` does."""
+    DDS orders the samples of one writer only, so the node may see an epoch and the IMU
+    sample of the same stamp in either order: the engine's result does not depend on it,
+    and the node must still equal `gnss_ins replay` exactly."""
     sent = {'/imu': 0, '/gnss/measurements': 0}
     t0_ns = inputs[0][0]
     start = time.monotonic()
-    previous = None
     for t_ns, topic, message in inputs:
         due = (t_ns - t0_ns) * 1e-9 / speed
         wait = due - (time.monotonic() - start)
-        if previous is not None and topic != previous:
-            wait = max(wait, TOPIC_SWITCH_GAP_S)
-        previous = topic
         if wait > 0:
             time.sleep(wait)
         (peer.imu if topic == '/imu' else peer.gnss).write(message)

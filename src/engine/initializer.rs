@@ -49,6 +49,8 @@ pub enum InitPhase {
 #[derive(Debug, Clone)]
 struct Leveling {
     t_start_s: f64,
+    /// The newest sample summed.
+    last_t_s: f64,
     sum_f: Vector3<f64>,
     sum_w: Vector3<f64>,
     count: usize,
@@ -114,10 +116,16 @@ impl Initializer {
         }
         let lev = self.leveling.get_or_insert(Leveling {
             t_start_s: s.t_s,
+            last_t_s: f64::NEG_INFINITY,
             sum_f: Vector3::zeros(),
             sum_w: Vector3::zeros(),
             count: 0,
         });
+        // A late measurement re-feeds the buffered samples: each counts once.
+        if s.t_s <= lev.last_t_s {
+            return;
+        }
+        lev.last_t_s = s.t_s;
         lev.sum_f += s.f_ib_b_m_s2;
         lev.sum_w += s.w_ib_b_rad_s;
         lev.count += 1;

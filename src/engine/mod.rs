@@ -7,9 +7,13 @@
 //! - IMU samples must arrive with strictly increasing stamps; a duplicate or an older one
 //!   is rejected and counted. A gap longer than `engine.max_imu_gap_s` resets the filter
 //!   (nothing can be integrated across it) and it starts again from the next position.
-//! - A GNSS measurement newer than the last IMU sample waits until the IMU reaches it; the
-//!   state is then propagated to its exact time with an interpolated IMU sample, updated,
-//!   and propagated on.
+//! - A GNSS measurement at or after the last IMU sample waits until an IMU sample after
+//!   it arrives; the state is then propagated to its exact time with an interpolated IMU
+//!   sample, updated, and propagated on. Choice: a measurement stamped exactly at an IMU
+//!   sample is applied after that sample (the solution of that sample is the propagated
+//!   one), whichever of the two arrives first: over DDS the IMU and GNSS streams have no
+//!   common order, and the result must not depend on it (the live node then equals the
+//!   offline replay of the same data).
 //! - A measurement older than the last IMU sample (late delivery) rolls the filter back to
 //!   the last stored state before it, applies it, and re-integrates the buffered IMU
 //!   samples; one older than `engine.imu_buffer_s` is rejected and counted.
@@ -276,7 +280,7 @@ impl Engine {
                 .counters
                 .reject(RejectionReason::MeasurementDuplicate, t));
         }
-        if t > last_t {
+        if t >= last_t {
             self.enqueue(m, false);
             return Ok(Vec::new());
         }
@@ -353,7 +357,7 @@ impl Engine {
         while self
             .pending
             .first()
-            .is_some_and(|p| p.measurement.t_s() <= s.t_s)
+            .is_some_and(|p| p.measurement.t_s() < s.t_s)
         {
             let p = self.pending.remove(0);
             self.apply_measurement(&p, s, out);

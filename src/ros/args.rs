@@ -4,7 +4,9 @@
 //! Understood after `--ros-args` (which may appear several times; `--` ends a block):
 //! `--params-file FILE`, `-p|--param name:=value`, `-r|--remap from:=to` (topic names,
 //! plus the special `__node:=NAME` and `__ns:=/NS`), `--log-level LEVEL`.
-//! Anything else is an error that names the argument: the node has no arguments of its own.
+//! Before `--ros-args`, the node's own argument: `--record OUT.mcap` (write everything the
+//! node publishes to a rosbag2 MCAP bag). Anything else is an error that names the
+//! argument.
 
 use std::path::PathBuf;
 
@@ -26,6 +28,8 @@ pub struct NodeArgs {
     pub remaps: Vec<(String, String)>,
     /// `--log-level` value, if given.
     pub log_level: Option<String>,
+    /// `--record OUT.mcap`: the bag that receives every message the node publishes.
+    pub record: Option<PathBuf>,
 }
 
 impl Default for NodeArgs {
@@ -37,6 +41,7 @@ impl Default for NodeArgs {
             parameters: Vec::new(),
             remaps: Vec::new(),
             log_level: None,
+            record: None,
         }
     }
 }
@@ -44,7 +49,7 @@ impl Default for NodeArgs {
 /// A command line the node does not accept.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum ArgsError {
-    #[error("unknown argument `{0}` (the node takes only ROS arguments: --ros-args --params-file FILE, -p name:=value, -r from:=to, -r __node:=NAME, -r __ns:=/NS, --log-level LEVEL)")]
+    #[error("unknown argument `{0}` (the node takes `--record OUT.mcap`, then ROS arguments: --ros-args --params-file FILE, -p name:=value, -r from:=to, -r __node:=NAME, -r __ns:=/NS, --log-level LEVEL)")]
     Unknown(String),
     #[error("`{0}` needs a value")]
     MissingValue(String),
@@ -112,6 +117,11 @@ where
             continue;
         }
         if !in_ros_args {
+            if arg == "--record" && out.record.is_none() {
+                let file = it.next().ok_or(ArgsError::MissingValue(arg))?;
+                out.record = Some(PathBuf::from(file));
+                continue;
+            }
             return Err(ArgsError::Unknown(arg));
         }
         let mut value_of = |flag: &str| it.next().ok_or(ArgsError::MissingValue(flag.to_owned()));
@@ -223,6 +233,19 @@ mod tests {
         assert_eq!(a.node_name, "ins");
         assert_eq!(a.namespace, "/robot1");
         assert_eq!(a.log_level.as_deref(), Some("debug"));
+    }
+
+    #[test]
+    fn record_comes_before_the_ros_args() {
+        let a = p(&["--record", "out.mcap", "--ros-args", "-r", "__node:=ins"]).unwrap();
+        assert_eq!(a.record, Some(PathBuf::from("out.mcap")));
+        assert_eq!(
+            p(&["--record"]),
+            Err(ArgsError::MissingValue("--record".into()))
+        );
+        // Once only, and not inside the ROS block.
+        assert!(p(&["--record", "a.mcap", "--record", "b.mcap"]).is_err());
+        assert!(p(&["--ros-args", "--record", "a.mcap"]).is_err());
     }
 
     #[test]

@@ -119,6 +119,12 @@ pub const TF_MESSAGE_MSG: &str = "geometry_msgs/TransformStamped[] transforms\n"
 /// `rosgraph_msgs/Clock`.
 pub const CLOCK_MSG: &str = "builtin_interfaces/Time clock\n";
 
+/// `rcl_interfaces/Log` (what /rosout carries).
+pub const LOG_MSG: &str =
+    "byte DEBUG=10\nbyte INFO=20\nbyte WARN=30\nbyte ERROR=40\nbyte FATAL=50\n\
+builtin_interfaces/Time stamp\nuint8 level\nstring name\nstring msg\nstring file\n\
+string function\nuint32 line\n";
+
 /// Every known definition text, keyed by `pkg/Type` (no `msg/` in the middle).
 const DEFINITIONS: &[(&str, &str)] = &[
     ("builtin_interfaces/Time", TIME_MSG),
@@ -148,6 +154,7 @@ const DEFINITIONS: &[(&str, &str)] = &[
     ("diagnostic_msgs/DiagnosticArray", DIAGNOSTIC_ARRAY_MSG),
     ("tf2_msgs/TFMessage", TF_MESSAGE_MSG),
     ("rosgraph_msgs/Clock", CLOCK_MSG),
+    ("rcl_interfaces/Log", LOG_MSG),
     (
         "adaptive_gnss_ins/SatelliteMeasurement",
         SATELLITE_MEASUREMENT_MSG,

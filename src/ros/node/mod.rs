@@ -14,6 +14,7 @@ pub mod log_limit;
 mod param_docs;
 pub mod param_server;
 pub mod params;
+pub mod recorder;
 pub mod rosout;
 pub mod services;
 
@@ -29,7 +30,7 @@ use ros2_client::{
 use crate::ros::args::NodeArgs;
 use crate::ros::msg::{
     Clock, DiagnosticArray, GnssMeasurements, Imu, Log, NavSatFix, NoiseEstimates, Odometry,
-    RosMessage,
+    RosMessage, Time,
 };
 use crate::ros::names::resolve_remapped;
 
@@ -39,6 +40,7 @@ use input_stats::{InputStats, Stream};
 use log_limit::LogLimiter;
 use param_server::ParameterServer;
 use params::NodeParams;
+use recorder::Recorder;
 use rosout::{LogLine, LogLines};
 pub use services::service_mapping_from;
 use services::{ParamRequest, ParameterServices};
@@ -61,6 +63,8 @@ pub enum NodeError {
     Dds(String),
     #[error("invalid topic name `{0}`")]
     TopicName(String),
+    #[error("{0}")]
+    Record(String),
 }
 
 /// The DDS domain of `ROS_DOMAIN_ID` (unset or empty: 0).
@@ -132,14 +136,6 @@ fn subscription<M: RosMessage + 'static>(
         .map_err(dds_error)
 }
 
-fn publisher<M: RosMessage>(
-    node: &mut Node,
-    names: &Names,
-    relative: &str,
-) -> Result<Publisher<M>, NodeError> {
-    publisher_with::<M>(node, names, relative, output_qos())
-}
-
 fn publisher_with<M: RosMessage>(
     node: &mut Node,
     names: &Names,
@@ -163,6 +159,7 @@ enum Event {
     Param(ParamRequest),
     LogLine(LogLine),
     Tick,
+    Shutdown,
 }
 
 /// How the node meets the DDS world: the domain and the service request/reply mapping.
@@ -174,20 +171,56 @@ pub struct DdsOptions {
     pub service_mapping: ServiceMapping,
 }
 
+/// A publisher with its resolved topic name (what a recording names the topic).
+struct Output<M: RosMessage> {
+    publisher: Publisher<M>,
+    topic: String,
+}
+
+impl<M: RosMessage + std::fmt::Debug> Output<M> {
+    fn new(node: &mut Node, names: &Names, relative: &str) -> Result<Self, NodeError> {
+        Self::with_qos(node, names, relative, output_qos())
+    }
+
+    fn with_qos(
+        node: &mut Node,
+        names: &Names,
+        relative: &str,
+        qos: QosProfile,
+    ) -> Result<Self, NodeError> {
+        Ok(Self {
+            publisher: publisher_with(node, names, relative, qos)?,
+            topic: names.topic(relative)?.to_string(),
+        })
+    }
+
+    /// Publishes `message`, recording it first when a recording is open.
+    fn send(&self, message: M, recorder: &mut Option<Recorder>, now: Time) -> Result<(), String> {
+        if let Some(r) = recorder.as_mut() {
+            r.record(&self.topic, &message, now);
+        }
+        self.publisher
+            .publish(message)
+            .map_err(|e| format!("{}: {e:?}", self.topic))
+    }
+}
+
 struct Outputs {
-    odometry: Publisher<Odometry>,
-    fix: Publisher<NavSatFix>,
-    noise: Publisher<NoiseEstimates>,
+    odometry: Output<Odometry>,
+    fix: Output<NavSatFix>,
+    noise: Output<NoiseEstimates>,
+    recorder: Option<Recorder>,
     log: LogLimiter,
 }
 
 impl Outputs {
-    fn publish(&mut self, msgs: Vec<OutMsg>) {
+    fn publish(&mut self, msgs: Vec<OutMsg>, now: Time) {
         for m in msgs {
+            let recorder = &mut self.recorder;
             let result = match m {
-                OutMsg::Odometry(o) => self.odometry.publish(*o).map_err(|e| format!("{e:?}")),
-                OutMsg::Fix(f) => self.fix.publish(f).map_err(|e| format!("{e:?}")),
-                OutMsg::Noise(n) => self.noise.publish(n).map_err(|e| format!("{e:?}")),
+                OutMsg::Odometry(o) => self.odometry.send(*o, recorder, now),
+                OutMsg::Fix(f) => self.fix.send(f, recorder, now),
+                OutMsg::Noise(n) => self.noise.send(n, recorder, now),
             };
             if let Err(e) = result {
                 self.log.warn("publish", &format!("publish failed: {e}"));
@@ -223,14 +256,19 @@ pub fn run(
     let gnss_sub = subscription::<GnssMeasurements>(&mut node, &names, "gnss/measurements")?;
     let fix_sub = subscription::<NavSatFix>(&mut node, &names, "gnss/fix")?;
     let clock_sub = subscription::<Clock>(&mut node, &names, "/clock")?;
+    let recorder = match &args.record {
+        Some(path) => Some(Recorder::create(path).map_err(NodeError::Record)?),
+        None => None,
+    };
     let mut outputs = Outputs {
-        odometry: publisher(&mut node, &names, "odometry")?,
-        fix: publisher(&mut node, &names, "fix")?,
-        noise: publisher(&mut node, &names, "~/noise_estimates")?,
+        odometry: Output::new(&mut node, &names, "odometry")?,
+        fix: Output::new(&mut node, &names, "fix")?,
+        noise: Output::new(&mut node, &names, "~/noise_estimates")?,
+        recorder,
         log: LogLimiter::default(),
     };
-    let diagnostics = publisher::<DiagnosticArray>(&mut node, &names, "/diagnostics")?;
-    let rosout = publisher_with::<Log>(&mut node, &names, "/rosout", rosout_qos())?;
+    let diagnostics = Output::<DiagnosticArray>::new(&mut node, &names, "/diagnostics")?;
+    let rosout = Output::<Log>::with_qos(&mut node, &names, "/rosout", rosout_qos())?;
     let services = ParameterServices::new(&mut node, dds.service_mapping)?;
     let config = params.config;
     let fqn = node.fully_qualified_name();
@@ -269,6 +307,12 @@ pub fn run(
     );
     if let Some(lines) = log_lines {
         sources.push(lines.map(Event::LogLine).boxed_local());
+    }
+    // SIGINT / SIGTERM end the loop so that a recording is completed; without a handler
+    // the process would die with the bag unfinished.
+    match async_signal::Signals::new([async_signal::Signal::Int, async_signal::Signal::Term]) {
+        Ok(signals) => sources.push(signals.map(|_| Event::Shutdown).boxed_local()),
+        Err(e) => log::warn!("cannot handle SIGINT/SIGTERM ({e}); stopping kills the node"),
     }
     let mut events = stream::select_all(sources);
     log::info!(
@@ -319,7 +363,7 @@ pub fn run(
                     let stamp = clock.now(parameters.use_sim_time());
                     let message = rosout::rosout_message(line, &logger, stamp);
                     // Not logged again: a failure here would feed itself.
-                    let _ = rosout.publish(message);
+                    let _ = rosout.send(message, &mut outputs.recorder, stamp);
                     Vec::new()
                 }
                 Event::Tick => {
@@ -328,15 +372,22 @@ pub fn run(
                     if let Some(status) = report.status.first_mut() {
                         stats.report(status, now_s());
                     }
-                    if let Err(e) = diagnostics.publish(report) {
-                        log::warn!("publishing diagnostics failed: {e:?}");
+                    if let Err(e) = diagnostics.send(report, &mut outputs.recorder, stamp) {
+                        log::warn!("publishing diagnostics failed: {e}");
                     }
                     Vec::new()
                 }
+                Event::Shutdown => {
+                    log::info!("{fqn}: stopping on a signal");
+                    break;
+                }
             };
-            outputs.publish(msgs);
+            outputs.publish(msgs, clock.now(parameters.use_sim_time()));
         }
     });
+    if let Some(recorder) = outputs.recorder.take() {
+        recorder.finish();
+    }
     Ok(())
 }
 
