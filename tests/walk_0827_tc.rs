@@ -7,6 +7,7 @@ use std::sync::OnceLock;
 
 use adaptive_gnss_ins::config::Config;
 use adaptive_gnss_ins::eval::ErrorSummary;
+use adaptive_gnss_ins::gnss::ionosphere::IonosphereMode;
 use adaptive_gnss_ins::tools::convert::{
     convert, ConvertOptions, EphemerisMode, ImuInput, ImuTime, TruthInput,
 };
@@ -74,6 +75,7 @@ fn options() -> ConvertOptions {
         },
         leap_seconds: DEFAULT_GPS_UTC_LEAP_S,
         ephemeris: EphemerisMode::WholeLog,
+        ionosphere: IonosphereMode::IonoFree,
     }
 }
 

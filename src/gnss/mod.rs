@@ -4,6 +4,7 @@
 pub mod atmosphere;
 pub mod ephemeris;
 pub mod geometry;
+pub mod ionosphere;
 mod observation;
 pub mod rinex_nav;
 pub mod spp;

@@ -64,7 +64,8 @@ impl SppReport {
     }
 }
 
-/// The single-point settings of a filter configuration: its elevation mask and σ model.
+/// The single-point settings of a filter configuration: its elevation mask and σ model,
+/// with one receiver clock (as the filter has).
 pub fn spp_config(config: &Config) -> SppConfig {
     SppConfig {
         elevation_mask_rad: config.gnss.elevation_mask_rad,
@@ -74,9 +75,23 @@ pub fn spp_config(config: &Config) -> SppConfig {
 }
 
 /// Solves every GNSS epoch of `inputs` with the constellations and settings of `config`
-/// and scores the solutions against the reference samples of `inputs`.
+/// (one receiver clock, as the filter) and scores the solutions against the reference
+/// samples of `inputs`.
 pub fn run_spp(inputs: impl Iterator<Item = SessionInput>, config: &Config) -> SppReport {
-    let settings = spp_config(config);
+    run_spp_with(inputs, config, false)
+}
+
+/// [`run_spp`] with one receiver clock per constellation when `clock_per_constellation`
+/// (see [`SppConfig::clock_per_constellation`]).
+pub fn run_spp_with(
+    inputs: impl Iterator<Item = SessionInput>,
+    config: &Config,
+    clock_per_constellation: bool,
+) -> SppReport {
+    let settings = SppConfig {
+        clock_per_constellation,
+        ..spp_config(config)
+    };
     let mut epochs: Vec<GnssEpoch> = Vec::new();
     let mut truth: Vec<TruthSample> = Vec::new();
     let mut labels: Vec<(f64, String)> = Vec::new();

@@ -25,7 +25,7 @@ mod sfrbx;
 
 pub use beidou_d1::{d1_subframe, decode_d1_ephemeris, D1Subframe};
 pub use bits::Bits;
-pub use epoch::{build_epoch, preferred_signals, BuiltEpoch, EpochStats};
+pub use epoch::{build_epoch, build_epoch_with, preferred_signals, BuiltEpoch, EpochStats};
 pub use error::UbxError;
 pub use frame::{checksum, encode_frame, FrameReader, FrameStats, UbxFrame};
 pub use galileo_inav::{crc24q, decode_inav_ephemeris, inav_word, InavWord};
@@ -38,5 +38,5 @@ pub use nav_decoder::{NavDecoder, NavDecoderStats, NavUpdate};
 pub use nav_error::NavDataError;
 pub use nav_pvt::{decode_nav_pvt, CarrierSolution, NavPvt};
 pub use rawx::{decode_rawx, RawMeasurement, RawX, TrackingStatus};
-pub use reader::{read_ubx_log, UbxLog, UbxLogStats};
+pub use reader::{read_ubx_log, read_ubx_log_with, UbxLog, UbxLogStats};
 pub use sfrbx::{decode_sfrbx, Sfrbx};
