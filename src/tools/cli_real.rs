@@ -311,6 +311,9 @@ pub fn spp(args: SppArgs) -> Result<(), String> {
     for (reason, n) in &report.failures {
         println!("  {n} epochs: {reason}");
     }
+    for (c, (bias_m, n)) in report.mean_inter_system_biases_m() {
+        println!("  inter-system bias of {c:?} against the first clock: {bias_m:.3} m mean over {n} epochs");
+    }
     println!(
         "{:<14} {:>7} {:>8} {:>8} {:>8}",
         "reference", "epochs", "horiz_m", "vert_m", "pos3d_m"
