@@ -157,3 +157,118 @@ fn iono_free_spp_removes_the_ionospheric_height_bias() {
     );
     assert!(horizontal_rms(&free) < horizontal_rms(&broadcast));
 }
+
+/// Residuals of the ionosphere-free ranges at the reference position of each epoch (the
+/// NAV-PVT solution), with the elevation mask of the single point (10°).
+struct ReferenceResiduals {
+    /// Per epoch: (line of sight in ENU, residual m, constellation index 0 GPS / 1 Galileo).
+    epochs: Vec<Vec<(Vector3<f64>, f64, usize)>>,
+}
+
+fn reference_residuals(log: &UbxLog) -> ReferenceResiduals {
+    use adaptive_gnss_ins::gnss::geometry::predict;
+    use adaptive_gnss_ins::gnss::Constellation;
+    let mut epochs = Vec::new();
+    for raw in &log.rawx {
+        let built = build_epoch_with(raw, &log.store, None, IonosphereMode::IonoFree);
+        let tow = built.receive_time.tow_s;
+        let Some(pvt) = log
+            .nav_pvt
+            .iter()
+            .find(|p| (f64::from(p.itow_ms) * 1e-3 - tow).abs() < 0.05)
+        else {
+            continue;
+        };
+        let reference = Llh::new(pvt.lat_rad, pvt.lon_rad, pvt.height_m);
+        let r = llh_to_ecef(&reference);
+        let rows: Vec<_> = built
+            .epoch
+            .satellites
+            .iter()
+            .filter_map(|obs| {
+                let p = predict(obs, &r, &Vector3::zeros(), 0.0, 0.0, None, tow).ok()?;
+                let group = usize::from(obs.sat.constellation == Constellation::Galileo);
+                (p.elevation_rad > 10f64.to_radians()).then(|| {
+                    (
+                        rot_ecef_to_enu(&reference) * p.los_ecef,
+                        obs.pseudorange_m - p.pseudorange_m,
+                        group,
+                    )
+                })
+            })
+            .collect();
+        epochs.push(rows);
+    }
+    ReferenceResiduals { epochs }
+}
+
+/// Least squares of one epoch's residuals on a clock per system and, with `offset`, a
+/// position offset Δ (ENU): v = −e·Δ + clock. Returns Δ (zero without) and the RMS left.
+fn fit(rows: &[(Vector3<f64>, f64, usize)], offset: bool) -> Option<(Vector3<f64>, f64)> {
+    let n_pos = if offset { 3 } else { 0 };
+    let unknowns = n_pos + 2;
+    if rows.len() < unknowns + 2 || !(0..2).all(|g| rows.iter().any(|r| r.2 == g)) {
+        return None;
+    }
+    let mut h = nalgebra::DMatrix::<f64>::zeros(rows.len(), unknowns);
+    let mut y = nalgebra::DVector::<f64>::zeros(rows.len());
+    for (i, (e, v, g)) in rows.iter().enumerate() {
+        for k in 0..n_pos {
+            h[(i, k)] = -e[k];
+        }
+        h[(i, n_pos + g)] = 1.0;
+        y[i] = *v;
+    }
+    let x = (h.transpose() * &h).try_inverse()? * h.transpose() * &y;
+    let left = &y - &h * &x;
+    let delta = if offset {
+        Vector3::new(x[0], x[1], x[2])
+    } else {
+        Vector3::zeros()
+    };
+    Some((delta, (left.norm_squared() / rows.len() as f64).sqrt()))
+}
+
+/// What the iono-free single point's remaining error looks like: at the reference
+/// positions, the residuals of GPS and Galileo fit a position offset (the same in every
+/// epoch) to about a metre, and a clock alone leaves several metres.
+#[test]
+fn iono_free_residuals_at_the_reference_fit_one_position_offset() {
+    let log = log();
+    let residuals = reference_residuals(&log);
+    let (mut deltas, mut with, mut without) = (Vec::new(), Vec::new(), Vec::new());
+    for rows in &residuals.epochs {
+        if let (Some((d, rms)), Some((_, rms0))) = (fit(rows, true), fit(rows, false)) {
+            deltas.push(d);
+            with.push(rms);
+            without.push(rms0);
+        }
+    }
+    let n = deltas.len() as f64;
+    let mean_delta = deltas.iter().sum::<Vector3<f64>>() / n;
+    let spread = (deltas
+        .iter()
+        .map(|d| (d - mean_delta).component_mul(&(d - mean_delta)))
+        .sum::<Vector3<f64>>()
+        / n)
+        .map(f64::sqrt);
+    let median = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let (rms_with, rms_without) = (median(&mut with), median(&mut without));
+    println!(
+        "{} epochs: position offset of the reference mean {:.2?} m (ENU), spread {:.2?} m; \
+         median residual RMS {rms_with:.2} m with the offset, {rms_without:.2} m with \
+         clocks alone",
+        deltas.len(),
+        mean_delta.as_slice(),
+        spread.as_slice()
+    );
+    assert!(deltas.len() > 500);
+    assert!(rms_with < 1.5, "{rms_with} m left with an offset");
+    assert!(
+        rms_without > 2.0 * rms_with,
+        "{rms_without} m with clocks alone"
+    );
+}
