@@ -14,7 +14,8 @@
 //!   the receive time.
 
 use crate::gnss::ephemeris::{
-    fill_satellite_fields, EphemerisError, EphemerisStore, GpsTime, Signal, SECONDS_PER_WEEK,
+    fill_satellite_fields, EphemerisError, EphemerisStore, GpsTime, RangingCode, Signal,
+    SECONDS_PER_WEEK,
 };
 use crate::gnss::{Constellation, GnssEpoch, Klobuchar, SatId, SatObservation};
 
@@ -38,6 +39,8 @@ pub struct EpochStats {
     pub satellites: usize,
     /// Satellites of a system or with signals this crate does not use.
     pub unsupported: usize,
+    /// Satellites left out for lack of a dual-frequency pair (ionosphere-free mode).
+    pub single_frequency: usize,
     /// Satellites skipped for lack of a healthy, valid ephemeris.
     pub no_ephemeris: usize,
     /// Satellites skipped for another ephemeris problem (group delay, non-finite).
@@ -53,8 +56,8 @@ pub struct BuiltEpoch {
     pub epoch: GnssEpoch,
     /// Receive time (GPST, receiver clock).
     pub receive_time: GpsTime,
-    /// Signal used for each satellite of `epoch.satellites`, in the same order.
-    pub signals: Vec<Signal>,
+    /// Signal or combination used for each satellite of `epoch.satellites`, in order.
+    pub signals: Vec<RangingCode>,
     /// Counts.
     pub stats: EpochStats,
 }
@@ -79,13 +82,14 @@ pub fn unfilled_observation(sat: SatId, pseudorange_m: f64) -> SatObservation {
 }
 
 /// The epoch received at `receive_time` from the chosen measurement of each satellite
-/// (`candidates`: signal and observation with its satellite fields unfilled): each gets
+/// (`candidates`: signal or combination, and the observation with its satellite fields
+/// unfilled): each gets
 /// its satellite state from the ephemeris `store` selects, or is counted and left out.
 /// `stats` comes with the input counts (measurements, satellites, unsupported); the
 /// ephemeris counts and `used` are added here. `klobuchar` is passed through.
 pub fn complete_epoch(
     receive_time: GpsTime,
-    candidates: impl IntoIterator<Item = (Signal, SatObservation)>,
+    candidates: impl IntoIterator<Item = (RangingCode, SatObservation)>,
     store: &EphemerisStore,
     klobuchar: Option<Klobuchar>,
     mut stats: EpochStats,

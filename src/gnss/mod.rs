@@ -5,6 +5,7 @@ pub mod atmosphere;
 pub mod ephemeris;
 pub mod epoch_build;
 pub mod geometry;
+pub mod ionosphere;
 mod observation;
 pub mod rinex_nav;
 pub mod rinex_obs;

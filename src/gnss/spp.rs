@@ -3,9 +3,15 @@
 //! squares (Gauss-Newton) on the measurement model of [`crate::gnss::geometry`].
 //!
 //! Choices:
-//! - One receiver clock for all satellites: multi-constellation inter-system time offsets
-//!   are assumed corrected at the ephemeris level (satellite clocks referred to one time
-//!   scale), as the message contract's satellite clock field implies.
+//! - Receiver clock: one for all satellites by default (multi-constellation time offsets
+//!   assumed corrected at the ephemeris level, as the message contract's satellite clock
+//!   field implies), or, with [`SppConfig::clock_per_constellation`], one per
+//!   constellation present. The latter absorbs the inter-system biases a real receiver
+//!   has: the offsets between the systems' time scales (GST and BDT against GPST, a few
+//!   to tens of ns) and the receiver's own signal delays, which differ between the
+//!   frequencies and codes each system is tracked on. The reported clock bias and its
+//!   covariance are those of the first constellation in [`Constellation`] order (GPS
+//!   first); the others are listed in [`SppSolution::clock_biases_m`].
 //! - Weights are 1/σ² with σ = σ_zenith / sin(el) ([`SigmaModel`]); the covariance is
 //!   the a-priori (HᵀWH)⁻¹, not rescaled by the a-posteriori variance factor, so it is as
 //!   good as the σ model.
@@ -21,12 +27,13 @@
 //!   computed for every satellite; if the largest |w_i| exceeds the threshold and at
 //!   least 6 satellites are used (so one redundant measurement remains after the
 //!   removal), that satellite is excluded and the solution is iterated again. One at a
-//!   time, until no |w_i| exceeds the threshold.
+//!   time, until no |w_i| exceeds the threshold. With a clock per constellation the
+//!   unknowns are 3 + the number of clocks, and the 6 becomes that plus 2.
 //! - Velocity and clock drift: linear weighted least squares on the rates of the
 //!   satellites used for the position, at the converged position (exact in one step,
 //!   the rate model being linear in the receiver velocity and drift). No outlier test.
 
-use nalgebra::{Matrix3, Matrix4, Vector3, Vector4};
+use nalgebra::{DMatrix, DVector, Matrix3, Matrix4, Vector3, Vector4};
 use thiserror::Error;
 
 use crate::earth::{ecef_to_llh, rot_ecef_to_enu, Llh, SPEED_OF_LIGHT_M_S};
@@ -34,16 +41,18 @@ use crate::gnss::atmosphere::TroposphereModel;
 use crate::gnss::geometry::{
     line_of_sight, predict_with, DelayModels, GnssModelError, SatPrediction,
 };
-use crate::gnss::{GnssEpoch, SatId, SatObservation};
+use crate::gnss::{Constellation, GnssEpoch, SatId, SatObservation};
 
 /// Height band (± m about the ellipsoid) within which the iterate counts as "near the
 /// surface" and the elevation mask, elevation weights and atmosphere are applied.
 pub const NEAR_SURFACE_HEIGHT_M: f64 = 100_000.0;
 
-/// Unknowns of the position solution (x, y, z, clock) and of the velocity solution.
+/// Unknowns of the position solution with one clock (x, y, z, clock) and of the velocity
+/// solution (v_x, v_y, v_z, drift).
 const UNKNOWNS: usize = 4;
-/// Satellites needed so that one redundant measurement remains after excluding one.
-const MIN_SATS_FOR_OUTLIER_TEST: usize = UNKNOWNS + 2;
+/// Satellites beyond the unknowns needed for the outlier test, so that one redundant
+/// measurement remains after excluding one.
+const OUTLIER_TEST_REDUNDANCY: usize = 2;
 
 /// Measurement standard deviations as a function of elevation.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -118,12 +127,15 @@ pub struct SppConfig {
     pub outlier_threshold: Option<f64>,
     /// Tropospheric delay model for satellites whose observation carries no delay.
     pub troposphere: TroposphereModel,
+    /// Estimate one receiver clock per constellation instead of one for all (see the
+    /// module notes).
+    pub clock_per_constellation: bool,
 }
 
 impl Default for SppConfig {
     /// Mask 10°, default σ model, start at the earth's centre, 20 iterations,
     /// tolerance 0.1 mm, outlier threshold |w| > 4, Saastamoinen troposphere with the
-    /// Black & Eisner mapping.
+    /// Black & Eisner mapping, one clock for all satellites.
     fn default() -> Self {
         Self {
             elevation_mask_rad: 10f64.to_radians(),
@@ -133,6 +145,7 @@ impl Default for SppConfig {
             convergence_m: 1e-4,
             outlier_threshold: Some(4.0),
             troposphere: TroposphereModel::default(),
+            clock_per_constellation: false,
         }
     }
 }
@@ -226,8 +239,13 @@ pub struct SppSolution {
     pub pos_ecef_m: Vector3<f64>,
     /// Receiver position (geodetic).
     pub pos_llh: Llh,
-    /// Receiver clock bias c·δt_u (m).
+    /// Receiver clock bias c·δt_u (m); with a clock per constellation, the first
+    /// constellation's (in [`Constellation`] order).
     pub clock_bias_m: f64,
+    /// The clock bias (m) of each clock solved for: one entry per constellation used
+    /// with [`SppConfig::clock_per_constellation`], else one entry, for the first
+    /// constellation used, holding the common clock.
+    pub clock_biases_m: Vec<(Constellation, f64)>,
     /// Covariance of (x, y, z, clock bias) (m²).
     pub covariance: Matrix4<f64>,
     /// Residuals of the satellites used.
@@ -244,12 +262,60 @@ pub struct SppSolution {
     pub velocity: Result<SppVelocity, SppError>,
 }
 
+/// The receiver clocks being solved for: one for all satellites, or one per
+/// constellation of the epoch (in [`Constellation`] order).
+#[derive(Debug, Clone, PartialEq)]
+struct Clocks {
+    constellations: Vec<Constellation>,
+    per_constellation: bool,
+    values_m: Vec<f64>,
+}
+
+impl Clocks {
+    fn new(epoch: &GnssEpoch, per_constellation: bool) -> Self {
+        let mut constellations: Vec<Constellation> = epoch
+            .satellites
+            .iter()
+            .map(|s| s.sat.constellation)
+            .collect();
+        constellations.sort();
+        constellations.dedup();
+        if !per_constellation {
+            constellations.truncate(1);
+        }
+        let values_m = vec![0.0; constellations.len().max(1)];
+        Self {
+            constellations,
+            per_constellation,
+            values_m,
+        }
+    }
+
+    /// The clock of a constellation (index into `values_m`).
+    fn group(&self, c: Constellation) -> usize {
+        if self.per_constellation {
+            self.constellations
+                .iter()
+                .position(|&k| k == c)
+                .unwrap_or(0)
+        } else {
+            0
+        }
+    }
+
+    fn value_m(&self, c: Constellation) -> f64 {
+        self.values_m.get(self.group(c)).copied().unwrap_or(0.0)
+    }
+}
+
 /// One usable measurement row at the current iterate.
 struct Row {
     /// Index into the epoch's satellites.
     index: usize,
-    /// Partials of the pseudo-range w.r.t. (x, y, z, clock).
+    /// Partials of the pseudo-range w.r.t. (x, y, z) and the row's clock (+1).
     h: Vector4<f64>,
+    /// The row's clock (index into [`Clocks::values_m`]).
+    group: usize,
     residual: f64,
     sigma: f64,
     elevation_rad: Option<f64>,
@@ -271,6 +337,33 @@ impl Evaluation {
     }
 }
 
+/// Weighted least-squares solution of (x, y, z) and the clocks that have rows.
+struct LsqSolution {
+    /// Position step and one clock step per column of `groups`.
+    dx: DVector<f64>,
+    /// (HᵀWH)⁻¹ in the same order.
+    covariance: DMatrix<f64>,
+    /// The clock (index into [`Clocks::values_m`]) of each clock column, ascending.
+    groups: Vec<usize>,
+}
+
+impl LsqSolution {
+    /// The design row of `row` in this solution's unknowns.
+    fn design_row(&self, row: &Row) -> DVector<f64> {
+        let mut h = DVector::zeros(3 + self.groups.len());
+        h.rows_mut(0, 3).copy_from(&row.h.fixed_rows::<3>(0));
+        if let Some(col) = self.groups.iter().position(|&g| g == row.group) {
+            h[3 + col] = row.h[3];
+        }
+        h
+    }
+
+    /// Covariance of (x, y, z, first clock).
+    fn covariance4(&self) -> Matrix4<f64> {
+        Matrix4::from_fn(|i, j| self.covariance[(i, j)])
+    }
+}
+
 /// Single-point position, clock bias and (when rates are present) velocity and drift
 /// from `epoch`. See the module notes for the algorithm and its choices.
 pub fn solve_spp(epoch: &GnssEpoch, config: &SppConfig) -> Result<SppSolution, SppError> {
@@ -281,7 +374,7 @@ pub fn solve_spp(epoch: &GnssEpoch, config: &SppConfig) -> Result<SppSolution, S
     let mut pos = config
         .initial_position_ecef_m
         .unwrap_or_else(Vector3::zeros);
-    let mut clock_bias_m = 0.0;
+    let mut clocks = Clocks::new(epoch, config.clock_per_constellation);
     let mut outliers: Vec<(usize, f64)> = Vec::new();
     let mut iterations = 0;
 
@@ -291,13 +384,13 @@ pub fn solve_spp(epoch: &GnssEpoch, config: &SppConfig) -> Result<SppSolution, S
             config,
             &outliers,
             &mut pos,
-            &mut clock_bias_m,
+            &mut clocks,
             &mut iterations,
         )?;
-        let (_, covariance) = weighted_least_squares(&eval.rows)?;
-        let standardized = standardized_residuals(&eval.rows, &covariance);
+        let lsq = weighted_least_squares(&eval.rows)?;
+        let standardized = standardized_residuals(&eval.rows, &lsq);
         if let Some(threshold) = config.outlier_threshold {
-            if eval.rows.len() >= MIN_SATS_FOR_OUTLIER_TEST {
+            if eval.rows.len() >= lsq.dx.len() + OUTLIER_TEST_REDUNDANCY {
                 let worst = eval
                     .rows
                     .iter()
@@ -313,10 +406,10 @@ pub fn solve_spp(epoch: &GnssEpoch, config: &SppConfig) -> Result<SppSolution, S
         }
         let converged = Converged {
             eval,
-            covariance,
+            lsq,
             standardized,
             pos,
-            clock_bias_m,
+            clocks,
             iterations,
         };
         return finish(epoch, config, converged, &outliers);
@@ -326,10 +419,10 @@ pub fn solve_spp(epoch: &GnssEpoch, config: &SppConfig) -> Result<SppSolution, S
 /// The converged state of one Gauss-Newton run.
 struct Converged {
     eval: Evaluation,
-    covariance: Matrix4<f64>,
+    lsq: LsqSolution,
     standardized: Vec<f64>,
     pos: Vector3<f64>,
-    clock_bias_m: f64,
+    clocks: Clocks,
     iterations: usize,
 }
 
@@ -340,27 +433,31 @@ fn iterate(
     config: &SppConfig,
     outliers: &[(usize, f64)],
     pos: &mut Vector3<f64>,
-    clock_bias_m: &mut f64,
+    clocks: &mut Clocks,
     iterations: &mut usize,
 ) -> Result<Evaluation, SppError> {
     let mut last_step_m = f64::INFINITY;
     let mut previous_set: Option<Vec<usize>> = None;
     for _ in 0..config.max_iterations {
-        let eval = evaluate(epoch, config, outliers, pos, *clock_bias_m);
+        let eval = evaluate(epoch, config, outliers, pos, clocks);
         let used = eval.used();
         if last_step_m < config.convergence_m && previous_set.as_ref() == Some(&used) {
             return Ok(eval);
         }
-        let (dx, _) = weighted_least_squares(&eval.rows)?;
+        let lsq = weighted_least_squares(&eval.rows)?;
         *iterations += 1;
-        *pos += dx.fixed_rows::<3>(0);
-        *clock_bias_m += dx[3];
-        if !(pos.iter().all(|v| v.is_finite()) && clock_bias_m.is_finite()) {
+        *pos += lsq.dx.fixed_rows::<3>(0);
+        for (col, &g) in lsq.groups.iter().enumerate() {
+            if let Some(v) = clocks.values_m.get_mut(g) {
+                *v += lsq.dx[3 + col];
+            }
+        }
+        if !(pos.iter().all(|v| v.is_finite()) && clocks.values_m.iter().all(|v| v.is_finite())) {
             return Err(SppError::NonFinite {
                 iteration: *iterations,
             });
         }
-        last_step_m = dx.norm();
+        last_step_m = lsq.dx.norm();
         previous_set = Some(used);
     }
     Err(SppError::NotConverged {
@@ -369,14 +466,14 @@ fn iterate(
     })
 }
 
-/// Measurement rows at (pos, clock bias); satellites the model refuses or that are below
-/// the mask (near the surface only) are listed as excluded.
+/// Measurement rows at (pos, clocks); satellites the model refuses or that are below the
+/// mask (near the surface only) are listed as excluded.
 fn evaluate(
     epoch: &GnssEpoch,
     config: &SppConfig,
     outliers: &[(usize, f64)],
     pos: &Vector3<f64>,
-    clock_bias_m: f64,
+    clocks: &Clocks,
 ) -> Evaluation {
     let llh = ecef_to_llh(pos);
     let near_surface = llh.is_some_and(|p| p.height_m.abs() <= NEAR_SURFACE_HEIGHT_M);
@@ -393,6 +490,7 @@ fn evaluate(
             continue;
         }
         let sat = obs.sat;
+        let clock_bias_m = clocks.value_m(sat.constellation);
         if !obs.pseudorange_m.is_finite() {
             let e = GnssModelError::NonFinite {
                 sat,
@@ -453,6 +551,7 @@ fn evaluate(
         rows.push(Row {
             index,
             h: Vector4::new(-los[0], -los[1], -los[2], 1.0),
+            group: clocks.group(sat.constellation),
             residual: obs.pseudorange_m - predicted,
             sigma: config.sigma.pseudorange_sigma_m(obs, weighting_elevation),
             elevation_rad,
@@ -463,27 +562,42 @@ fn evaluate(
     Evaluation { rows, excluded }
 }
 
-/// Weighted least squares dx = (HᵀWH)⁻¹ HᵀW v with its covariance (HᵀWH)⁻¹.
-fn weighted_least_squares(rows: &[Row]) -> Result<(Vector4<f64>, Matrix4<f64>), SppError> {
-    let pairs: Vec<(Vector4<f64>, f64, f64)> =
-        rows.iter().map(|r| (r.h, r.residual, r.sigma)).collect();
-    solve_normal_equations(&pairs)
+/// Weighted least squares dx = (HᵀWH)⁻¹ HᵀW v with its covariance (HᵀWH)⁻¹, over the
+/// position and the clocks that have rows.
+fn weighted_least_squares(rows: &[Row]) -> Result<LsqSolution, SppError> {
+    let mut groups: Vec<usize> = rows.iter().map(|r| r.group).collect();
+    groups.sort_unstable();
+    groups.dedup();
+    let mut lsq = LsqSolution {
+        dx: DVector::zeros(0),
+        covariance: DMatrix::zeros(0, 0),
+        groups,
+    };
+    let design: Vec<(DVector<f64>, f64, f64)> = rows
+        .iter()
+        .map(|r| (lsq.design_row(r), r.residual, r.sigma))
+        .collect();
+    let (dx, covariance) = solve_normal_equations(&design, 3 + lsq.groups.len())?;
+    lsq.dx = dx;
+    lsq.covariance = covariance;
+    Ok(lsq)
 }
 
-/// Solves the normal equations of rows (h, v, σ); at least 4 rows and a positive-definite
-/// normal matrix are required.
+/// Solves the normal equations of rows (h, v, σ) with `unknowns` unknowns; at least that
+/// many rows and a positive-definite normal matrix are required.
 fn solve_normal_equations(
-    rows: &[(Vector4<f64>, f64, f64)],
-) -> Result<(Vector4<f64>, Matrix4<f64>), SppError> {
+    rows: &[(DVector<f64>, f64, f64)],
+    unknowns: usize,
+) -> Result<(DVector<f64>, DMatrix<f64>), SppError> {
     let usable = rows.len();
-    if usable < UNKNOWNS {
+    if usable < unknowns.max(UNKNOWNS) {
         return Err(SppError::NotEnoughSatellites {
             usable,
-            required: UNKNOWNS,
+            required: unknowns.max(UNKNOWNS),
         });
     }
-    let mut normal = Matrix4::zeros();
-    let mut rhs = Vector4::zeros();
+    let mut normal = DMatrix::zeros(unknowns, unknowns);
+    let mut rhs = DVector::zeros(unknowns);
     for (h, v, sigma) in rows {
         let w = 1.0 / (sigma * sigma);
         normal += h * h.transpose() * w;
@@ -502,10 +616,11 @@ fn solve_normal_equations(
 }
 
 /// Standardized residuals w_i = v_i / sqrt(σ_i² − h_i Q h_iᵀ) (0 where that vanishes).
-fn standardized_residuals(rows: &[Row], covariance: &Matrix4<f64>) -> Vec<f64> {
+fn standardized_residuals(rows: &[Row], lsq: &LsqSolution) -> Vec<f64> {
     rows.iter()
         .map(|r| {
-            let var = r.sigma * r.sigma - (r.h.transpose() * covariance * r.h)[0];
+            let h = lsq.design_row(r);
+            let var = r.sigma * r.sigma - (h.transpose() * &lsq.covariance * &h)[0];
             if var > 1e-12 * r.sigma * r.sigma {
                 r.residual / var.sqrt()
             } else {
@@ -515,11 +630,12 @@ fn standardized_residuals(rows: &[Row], covariance: &Matrix4<f64>) -> Vec<f64> {
         .collect()
 }
 
-/// Dilutions of precision from the unweighted geometry at `llh`.
-fn dops(rows: &[Row], llh: &Llh) -> Result<Dops, SppError> {
-    let unit: Vec<(Vector4<f64>, f64, f64)> = rows.iter().map(|r| (r.h, 0.0, 1.0)).collect();
-    let (_, q) = solve_normal_equations(&unit)?;
-    let q_pos: Matrix3<f64> = q.fixed_view::<3, 3>(0, 0).into_owned();
+/// Dilutions of precision from the unweighted geometry at `llh` (TDOP: the first clock).
+fn dops(rows: &[Row], lsq: &LsqSolution, llh: &Llh) -> Result<Dops, SppError> {
+    let unit: Vec<(DVector<f64>, f64, f64)> =
+        rows.iter().map(|r| (lsq.design_row(r), 0.0, 1.0)).collect();
+    let (_, q) = solve_normal_equations(&unit, lsq.dx.len())?;
+    let q_pos: Matrix3<f64> = Matrix3::from_fn(|i, j| q[(i, j)]);
     let c = rot_ecef_to_enu(llh);
     let q_enu = c * q_pos * c.transpose();
     Ok(Dops {
@@ -532,6 +648,9 @@ fn dops(rows: &[Row], llh: &Llh) -> Result<Dops, SppError> {
 }
 
 /// Velocity and clock drift from the rates of the used satellites at the solution.
+///
+/// Choice: one clock drift for all constellations even with a clock per constellation:
+/// the inter-system biases are constant over a session, so their rates vanish.
 fn solve_velocity(
     epoch: &GnssEpoch,
     config: &SppConfig,
@@ -554,10 +673,14 @@ fn solve_velocity(
         let sigma = config
             .sigma
             .pseudorange_rate_sigma_mps(obs, row.weighting_elevation_rad);
-        rate_rows.push((Vector4::new(d[0], d[1], d[2], 1.0), residual, sigma));
+        rate_rows.push((
+            DVector::from_vec(vec![d[0], d[1], d[2], 1.0]),
+            residual,
+            sigma,
+        ));
         sats.push(obs.sat);
     }
-    let (x, covariance) = solve_normal_equations(&rate_rows)?;
+    let (x, covariance) = solve_normal_equations(&rate_rows, UNKNOWNS)?;
     let vel_ecef_mps = Vector3::new(x[0], x[1], x[2]);
     let residuals = sats
         .iter()
@@ -568,7 +691,7 @@ fn solve_velocity(
         vel_ecef_mps,
         vel_enu_mps: rot_ecef_to_enu(llh) * vel_ecef_mps,
         clock_drift_mps: x[3],
-        covariance,
+        covariance: Matrix4::from_fn(|i, j| covariance[(i, j)]),
         residuals,
         num_used: rate_rows.len(),
     })
@@ -583,16 +706,16 @@ fn finish(
 ) -> Result<SppSolution, SppError> {
     let Converged {
         eval,
-        covariance,
+        lsq,
         standardized,
         pos,
-        clock_bias_m,
+        clocks,
         iterations,
     } = converged;
     let pos_llh = ecef_to_llh(&pos).ok_or(SppError::NonFinite {
         iteration: iterations,
     })?;
-    let dop = dops(&eval.rows, &pos_llh)?;
+    let dop = dops(&eval.rows, &lsq, &pos_llh)?;
     let residuals = eval
         .rows
         .iter()
@@ -618,12 +741,27 @@ fn finish(
             });
         }
     }
+    // The clocks solved for, named by the first constellation each serves.
+    let clock_biases_m: Vec<(Constellation, f64)> = lsq
+        .groups
+        .iter()
+        .filter_map(|&g| {
+            let row = eval.rows.iter().find(|r| r.group == g)?;
+            let c = epoch.satellites.get(row.index)?.sat.constellation;
+            Some((c, *clocks.values_m.get(g)?))
+        })
+        .collect();
+    let clock_bias_m = clock_biases_m.first().map_or_else(
+        || clocks.values_m.first().copied().unwrap_or(0.0),
+        |&(_, v)| v,
+    );
     let velocity = solve_velocity(epoch, config, &eval.rows, &pos_llh);
     Ok(SppSolution {
         pos_ecef_m: pos,
         pos_llh,
         clock_bias_m,
-        covariance,
+        clock_biases_m,
+        covariance: lsq.covariance4(),
         residuals,
         excluded,
         num_used: eval.rows.len(),

@@ -14,9 +14,10 @@ use super::imu_csv::{AccelUnit, GyroUnit, ImuCsvFormat};
 use super::replay::bag_inputs;
 use super::simulate::TRUTH_TOPIC;
 use super::spp_rinex::spp_rinex as solve_rinex_files;
-use super::spp_run::{run_spp, write_spp_csv};
+use super::spp_run::{run_spp_with, write_spp_csv};
 use super::time_scale::DEFAULT_GPS_UTC_LEAP_S;
 use crate::gnss::atmosphere::TroposphereModel;
+use crate::gnss::ionosphere::IonosphereMode;
 use crate::gnss::rinex_spp::{Ionosphere, RinexSppOptions};
 
 /// Unit of the accelerometer columns.
@@ -33,6 +34,42 @@ pub enum AccelUnitArg {
 pub enum GyroUnitArg {
     DegPerS,
     RadPerS,
+}
+
+/// How the pseudo-ranges deal with the ionosphere.
+#[derive(Clone, Copy, ValueEnum)]
+pub enum IonosphereArg {
+    /// Dual-frequency ionosphere-free combination (GPS L1 C/A + L2C, Galileo E1 + E5a or
+    /// E5b, BeiDou B1I + B3I or B2I); single-frequency satellites left out. The default:
+    /// it removes the ionospheric delay (metres), which a short log may carry no model
+    /// for, at about three times the code noise.
+    IonoFree,
+    /// One signal per satellite, corrected with the broadcast GPS Klobuchar model when
+    /// the log holds it (else not corrected).
+    Broadcast,
+    /// One signal per satellite, not corrected.
+    None,
+}
+
+impl IonosphereArg {
+    fn mode(self) -> IonosphereMode {
+        match self {
+            Self::IonoFree => IonosphereMode::IonoFree,
+            Self::Broadcast => IonosphereMode::Broadcast,
+            Self::None => IonosphereMode::None,
+        }
+    }
+}
+
+/// The receiver clocks of the single-point solution.
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ClockArg {
+    /// One clock for all satellites, as the filter has, so that the two are compared on
+    /// the same model. The default.
+    Common,
+    /// One clock per constellation: absorbs the inter-system biases of a multi-GNSS
+    /// receiver (time-scale offsets, per-signal receiver delays).
+    PerConstellation,
 }
 
 /// Which ephemerides give the satellite states.
@@ -88,6 +125,8 @@ pub struct ConvertArgs {
     pub leap_seconds: f64,
     #[arg(long, value_enum, default_value_t = EphemerisArg::WholeLog)]
     pub ephemeris: EphemerisArg,
+    #[arg(long, value_enum, default_value_t = IonosphereArg::IonoFree)]
+    pub ionosphere: IonosphereArg,
     /// Output bag.
     #[arg(long)]
     pub out: PathBuf,
@@ -149,6 +188,7 @@ impl ConvertArgs {
                 EphemerisArg::WholeLog => EphemerisMode::WholeLog,
                 EphemerisArg::AsReceived => EphemerisMode::AsReceived,
             },
+            ionosphere: self.ionosphere.mode(),
         })
     }
 }
@@ -174,6 +214,12 @@ pub struct SppArgs {
     /// With a UBX log: GPS − UTC leap seconds.
     #[arg(long, default_value_t = DEFAULT_GPS_UTC_LEAP_S)]
     pub leap_seconds: f64,
+    /// With a UBX log: the pseudo-ranges to form (as `convert --ionosphere`).
+    #[arg(long, value_enum, default_value_t = IonosphereArg::IonoFree)]
+    pub ionosphere: IonosphereArg,
+    /// Receiver clocks to solve for.
+    #[arg(long, value_enum, default_value_t = ClockArg::Common)]
+    pub clock: ClockArg,
     /// Output CSV of the solutions.
     #[arg(long)]
     pub csv: Option<PathBuf>,
@@ -182,11 +228,13 @@ pub struct SppArgs {
 fn print_convert_summary(out: &std::path::Path, s: &ConvertSummary) {
     eprintln!(
         "wrote {}: {} GNSS epochs ({:.1} satellites each; {} epochs without a usable \
-         satellite left out; Klobuchar {}), {} IMU samples, reference {:?}; UTC {:.3}..{:.3} s",
+         satellite left out; {:.1} single-frequency satellites per epoch left out; \
+         Klobuchar {}), {} IMU samples, reference {:?}; UTC {:.3}..{:.3} s",
         out.display(),
         s.gnss_epochs,
         s.satellites as f64 / s.gnss_epochs.max(1) as f64,
         s.empty_epochs,
+        s.single_frequency as f64 / s.gnss_epochs.max(1) as f64,
         if s.klobuchar { "present" } else { "absent" },
         s.imu_samples,
         s.truth,
@@ -239,6 +287,7 @@ pub fn spp(args: SppArgs) -> Result<(), String> {
             geoid_separation_m: args.geoid_separation_m,
             leap_seconds: args.leap_seconds,
             ephemeris: EphemerisArg::WholeLog,
+            ionosphere: args.ionosphere,
             out: temp.clone(),
         };
         convert_files(&convert.options()?, &temp).map_err(|e| e.to_string())?;
@@ -247,7 +296,8 @@ pub fn spp(args: SppArgs) -> Result<(), String> {
         args.input.clone()
     };
     let inputs = bag_inputs(&bag, Some(TRUTH_TOPIC.to_owned())).map_err(|e| e.to_string());
-    let report = inputs.map(|inputs| run_spp(inputs, &config));
+    let per_constellation = args.clock == ClockArg::PerConstellation;
+    let report = inputs.map(|inputs| run_spp_with(inputs, &config, per_constellation));
     if is_ubx {
         // Best effort: a temporary file left behind is harmless.
         let _ = std::fs::remove_file(&temp);
@@ -263,6 +313,9 @@ pub fn spp(args: SppArgs) -> Result<(), String> {
     );
     for (reason, n) in &report.failures {
         println!("  {n} epochs: {reason}");
+    }
+    for (c, (bias_m, n)) in report.mean_inter_system_biases_m() {
+        println!("  inter-system bias of {c:?} against the first clock: {bias_m:.3} m mean over {n} epochs");
     }
     println!(
         "{:<14} {:>7} {:>8} {:>8} {:>8}",

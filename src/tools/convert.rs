@@ -5,7 +5,8 @@
 //! - `/gnss/measurements`: GnssMeasurements, one per UBX-RXM-RAWX epoch with satellites,
 //!   stamped at the receiver's measurement time; satellite states from the broadcast
 //!   ephemerides decoded from UBX-RXM-SFRBX; Klobuchar coefficients when the log has them
-//!   (NaN otherwise);
+//!   (NaN otherwise); pseudo-ranges as [`ConvertOptions::ionosphere`] says (by default
+//!   the dual-frequency ionosphere-free combination, ionosphere delay 0 per satellite);
 //! - `/imu`: sensor_msgs/Imu in the FLU body frame `base_link` (REP-103/145: specific
 //!   force in m/s², angular rate in rad/s), so the engine's `mounting.imu_rotation_rpy_deg`
 //!   stays [0, 0, 0] for a converted bag;
@@ -25,7 +26,8 @@ use std::path::{Path, PathBuf};
 use nalgebra::Vector3;
 
 use crate::earth::{self, Llh};
-use crate::gnss::ubx::{build_epoch, read_ubx_log, CarrierSolution, NavPvt, UbxLog};
+use crate::gnss::ionosphere::IonosphereMode;
+use crate::gnss::ubx::{build_epoch_with, read_ubx_log_with, CarrierSolution, NavPvt, UbxLog};
 use crate::ins::ImuSample;
 use crate::ros::bag::{BagError, BagWriter};
 use crate::ros::convert::seconds_to_time;
@@ -100,6 +102,8 @@ pub struct ConvertOptions {
     /// GPS − UTC (s).
     pub leap_seconds: f64,
     pub ephemeris: EphemerisMode,
+    /// Which pseudo-ranges to form (dual-frequency ionosphere-free or single-frequency).
+    pub ionosphere: IonosphereMode,
 }
 
 /// Why a conversion failed.
@@ -132,6 +136,8 @@ pub struct ConvertSummary {
     pub satellites: usize,
     /// RAWX epochs without a usable satellite (not written).
     pub empty_epochs: usize,
+    /// Satellite-epochs left out for lack of a dual-frequency pair (ionosphere-free).
+    pub single_frequency: usize,
     /// Whether the log had Klobuchar coefficients.
     pub klobuchar: bool,
     /// GPS − UTC the receiver reported (valid RAWX leap seconds), if it did.
@@ -183,7 +189,7 @@ fn stamp_of(gpst_s: f64, leap_s: f64) -> Result<(Time, u64), ConvertError> {
 /// Converts the inputs of `options` into the bag `out`.
 pub fn convert(options: &ConvertOptions, out: &Path) -> Result<ConvertSummary, ConvertError> {
     let ubx_path = options.ubx.display().to_string();
-    let log = read_ubx_log(&read(&options.ubx)?);
+    let log = read_ubx_log_with(&read(&options.ubx)?, options.ionosphere);
     let mut summary = ConvertSummary {
         klobuchar: log.klobuchar.is_some(),
         receiver_leap_seconds: log
@@ -280,12 +286,15 @@ fn gnss_items(
 ) -> Result<(), ConvertError> {
     for (k, raw) in log.rawx.iter().enumerate() {
         let built = match options.ephemeris {
-            EphemerisMode::WholeLog => build_epoch(raw, &log.store, log.klobuchar),
+            EphemerisMode::WholeLog => {
+                build_epoch_with(raw, &log.store, log.klobuchar, options.ionosphere)
+            }
             EphemerisMode::AsReceived => match log.epochs.get(k) {
                 Some(b) => b.clone(),
                 None => continue,
             },
         };
+        summary.single_frequency += built.stats.single_frequency;
         if built.epoch.satellites.is_empty() || !raw.rcv_tow_s.is_finite() {
             summary.empty_epochs += 1;
             continue;

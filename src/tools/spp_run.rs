@@ -14,7 +14,7 @@ use crate::earth::{self, Llh};
 use crate::engine::tight_update::sigma_model;
 use crate::eval::{self, ErrorSummary, SolutionError, TruthSample, TruthTrack};
 use crate::gnss::spp::{solve_spp, SppConfig};
-use crate::gnss::GnssEpoch;
+use crate::gnss::{Constellation, GnssEpoch};
 
 use super::session::SessionInput;
 
@@ -27,6 +27,8 @@ pub struct SppRow {
     pub t_s: f64,
     pub position: Llh,
     pub clock_bias_m: f64,
+    /// Every clock solved for (one per constellation, or the common one).
+    pub clock_biases_m: Vec<(Constellation, f64)>,
     pub satellites_used: usize,
     /// Error against the reference (ENU, m) and the reference's label, when scored.
     pub error: Option<(nalgebra::Vector3<f64>, String)>,
@@ -41,6 +43,25 @@ pub struct SppReport {
 }
 
 impl SppReport {
+    /// Mean inter-system bias of each constellation against the first clock of its
+    /// epoch (m), and the epochs it was solved in; empty with one common clock.
+    pub fn mean_inter_system_biases_m(&self) -> BTreeMap<Constellation, (f64, usize)> {
+        let mut sums: BTreeMap<Constellation, (f64, usize)> = BTreeMap::new();
+        for row in &self.rows {
+            let Some(&(_, first_m)) = row.clock_biases_m.first() else {
+                continue;
+            };
+            for &(c, clock_m) in row.clock_biases_m.iter().skip(1) {
+                let e = sums.entry(c).or_insert((0.0, 0));
+                e.0 += clock_m - first_m;
+                e.1 += 1;
+            }
+        }
+        sums.into_iter()
+            .map(|(c, (sum, n))| (c, (sum / n as f64, n)))
+            .collect()
+    }
+
     /// Error summaries by label, and over every scored epoch under "all".
     pub fn summary_by_label(&self) -> BTreeMap<String, ErrorSummary> {
         let mut by: BTreeMap<String, Vec<SolutionError>> = BTreeMap::new();
@@ -64,7 +85,8 @@ impl SppReport {
     }
 }
 
-/// The single-point settings of a filter configuration: its elevation mask and σ model.
+/// The single-point settings of a filter configuration: its elevation mask and σ model,
+/// with one receiver clock (as the filter has).
 pub fn spp_config(config: &Config) -> SppConfig {
     SppConfig {
         elevation_mask_rad: config.gnss.elevation_mask_rad,
@@ -74,9 +96,23 @@ pub fn spp_config(config: &Config) -> SppConfig {
 }
 
 /// Solves every GNSS epoch of `inputs` with the constellations and settings of `config`
-/// and scores the solutions against the reference samples of `inputs`.
+/// (one receiver clock, as the filter) and scores the solutions against the reference
+/// samples of `inputs`.
 pub fn run_spp(inputs: impl Iterator<Item = SessionInput>, config: &Config) -> SppReport {
-    let settings = spp_config(config);
+    run_spp_with(inputs, config, false)
+}
+
+/// [`run_spp`] with one receiver clock per constellation when `clock_per_constellation`
+/// (see [`SppConfig::clock_per_constellation`]).
+pub fn run_spp_with(
+    inputs: impl Iterator<Item = SessionInput>,
+    config: &Config,
+    clock_per_constellation: bool,
+) -> SppReport {
+    let settings = SppConfig {
+        clock_per_constellation,
+        ..spp_config(config)
+    };
     let mut epochs: Vec<GnssEpoch> = Vec::new();
     let mut truth: Vec<TruthSample> = Vec::new();
     let mut labels: Vec<(f64, String)> = Vec::new();
@@ -111,6 +147,7 @@ pub fn run_spp(inputs: impl Iterator<Item = SessionInput>, config: &Config) -> S
                     t_s: epoch.t_s,
                     position: sol.pos_llh,
                     clock_bias_m: sol.clock_bias_m,
+                    clock_biases_m: sol.clock_biases_m.clone(),
                     satellites_used: sol.num_used,
                     error,
                 });

@@ -5,6 +5,7 @@
 //! No I/O: decoders (`crate::gnss::ubx`, `crate::gnss::rinex_nav`) produce the elements.
 
 mod kepler;
+mod ranging;
 mod signal;
 mod store;
 mod time;
@@ -14,6 +15,7 @@ pub use kepler::{
     GroupDelay, KeplerianEphemeris, NavSource, SatState, SystemConstants, BEIDOU_CONSTANTS,
     GALILEO_CONSTANTS, GPS_CONSTANTS,
 };
+pub use ranging::{iono_free_coefficients, RangingCode};
 pub use signal::{group_delay_s, Signal};
 pub use store::{EphemerisStore, InsertOutcome, MAX_EPHEMERIDES_PER_SAT};
 pub use time::{

@@ -95,11 +95,16 @@ impl Signal {
 /// user of `signal`: Δt_sv(signal) = Δt_sv − T(signal). None when the ephemeris carries
 /// no correction for that signal (then the signal should not be used with it).
 ///
-/// - GPS/QZSS LNAV (IS-GPS-200 20.3.3.3.3.2): L1 C/A T_GD. L2C and L5 need the CNAV
-///   inter-signal corrections, which LNAV does not carry: None.
+/// - GPS/QZSS LNAV (IS-GPS-200 20.3.3.3.3.2): L1 C/A T_GD; L2C γ·T_GD, the L2 P(Y)
+///   correction. Choice: the CNAV inter-signal corrections ISC_L1C/A and ISC_L2C, which
+///   LNAV does not carry, are taken as zero (the C/A–P(Y) and L2C–P(Y) biases, typically
+///   below 1 ns). L5 needs ISC_L5, which LNAV has no stand-in for: None.
 /// - Galileo (OS SIS ICD 5.1.5): I/NAV clock (E1,E5b): E1 BGD(E1,E5b), E5b γ·BGD(E1,E5b);
-///   F/NAV clock (E1,E5a): E1 BGD(E1,E5a), E5a γ·BGD(E1,E5a); γ = (f_E1/f_E5)².
+///   F/NAV clock (E1,E5a): E1 BGD(E1,E5a), E5a γ·BGD(E1,E5a); γ = (f_E1/f_E5)². I/NAV also
+///   broadcasts BGD(E1,E5a), so E5a against the I/NAV clock is E1's correction plus the
+///   E5a−E1 delay difference of the F/NAV relations: BGD(E1,E5b) + (γ_E5a − 1)·BGD(E1,E5a).
 /// - BeiDou D1/D2 (BDS ICD 5.2.4.10): clock refers to B3I: B1I T_GD1, B2I T_GD2, B3I 0.
+///   B1C and B2a need the B-CNAV group delays, which D1/D2 do not carry: None.
 pub fn group_delay_s(eph: &KeplerianEphemeris, signal: Signal) -> Option<f64> {
     use super::kepler::NavSource;
     if signal.constellation() != eph.sat.constellation {
@@ -108,11 +113,19 @@ pub fn group_delay_s(eph: &KeplerianEphemeris, signal: Signal) -> Option<f64> {
     let gamma = |f: f64| (FREQ_L1_HZ / f) * (FREQ_L1_HZ / f);
     match (eph.group_delay, signal) {
         (GroupDelay::Gps { tgd_s }, Signal::GpsL1Ca | Signal::QzssL1Ca) => Some(tgd_s),
-        (GroupDelay::Galileo { bgd_e1_e5b_s, .. }, _) if eph.source == NavSource::GalileoInav => {
+        (GroupDelay::Gps { tgd_s }, Signal::GpsL2C) => Some(gamma(FREQ_L2_HZ) * tgd_s),
+        (
+            GroupDelay::Galileo {
+                bgd_e1_e5a_s,
+                bgd_e1_e5b_s,
+            },
+            _,
+        ) if eph.source == NavSource::GalileoInav => {
             let bgd = bgd_e1_e5b_s?;
             match signal {
                 Signal::GalileoE1 => Some(bgd),
                 Signal::GalileoE5b => Some(gamma(FREQ_E5B_HZ) * bgd),
+                Signal::GalileoE5a => Some(bgd + (gamma(FREQ_L5_HZ) - 1.0) * bgd_e1_e5a_s),
                 _ => None,
             }
         }

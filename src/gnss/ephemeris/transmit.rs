@@ -3,7 +3,8 @@
 use thiserror::Error;
 
 use super::kepler::{KeplerianEphemeris, SatState};
-use super::signal::{group_delay_s, Signal};
+use super::ranging::RangingCode;
+use super::signal::Signal;
 use super::store::EphemerisStore;
 use super::time::GpsTime;
 use crate::earth::SPEED_OF_LIGHT_M_S;
@@ -19,7 +20,8 @@ pub enum EphemerisError {
     /// No healthy ephemeris valid at the time.
     #[error("{sat}: no healthy ephemeris valid at GPS week {week} TOW {tow_s:.3} s")]
     NoEphemeris { sat: SatId, week: i32, tow_s: f64 },
-    /// The ephemeris has no group-delay correction for the signal.
+    /// The ephemeris has no group-delay correction for the signal (one of the two of a
+    /// combination).
     #[error("{sat}: ephemeris has no group delay for signal {signal:?}")]
     NoGroupDelay { sat: SatId, signal: Signal },
     /// A non-finite input or result.
@@ -34,14 +36,15 @@ pub struct TransmitState {
     pub t_tx: GpsTime,
     /// Position, velocity and clock at t_tx; position in the ECEF frame of t_tx.
     pub state: SatState,
-    /// Group delay applied for the signal (s).
+    /// Group delay applied for the measurement (signal or combination) (s).
     pub group_delay_s: f64,
-    /// Clock offset for this signal: `state.clock_bias_s − group_delay_s` (s).
+    /// Clock offset for this measurement: `state.clock_bias_s − group_delay_s` (s).
     pub clock_bias_s: f64,
 }
 
-/// Evaluates `eph` at the transmission time of a signal received at GPST `t_rx` (receiver
-/// clock) with pseudo-range `pseudorange_m`:
+/// Evaluates `eph` at the transmission time of a signal (or a combination of signals, see
+/// [`RangingCode`]) received at GPST `t_rx` (receiver clock) with pseudo-range
+/// `pseudorange_m`:
 ///   t_tx = t_rx − ρ/c − Δt_sv(t_tx),  Δt_sv = clock polynomial + relativistic − T_GD.
 ///
 /// Choice: the receiver clock offset is not known here and is not removed from t_rx, as
@@ -49,19 +52,21 @@ pub struct TransmitState {
 /// track, mostly absorbed by the receiver clock estimate.
 pub fn state_at_transmission(
     eph: &KeplerianEphemeris,
-    signal: Signal,
+    code: impl Into<RangingCode>,
     t_rx: &GpsTime,
     pseudorange_m: f64,
 ) -> Result<TransmitState, EphemerisError> {
     let sat = eph.sat;
+    let code = code.into();
     if !pseudorange_m.is_finite() || !t_rx.is_finite() {
         return Err(EphemerisError::NonFinite {
             sat,
             what: "pseudo-range or receive time",
         });
     }
-    let group_delay_s =
-        group_delay_s(eph, signal).ok_or(EphemerisError::NoGroupDelay { sat, signal })?;
+    let group_delay_s = code
+        .group_delay_s(eph)
+        .map_err(|signal| EphemerisError::NoGroupDelay { sat, signal })?;
     let t_nominal = t_rx.add_seconds(-pseudorange_m / SPEED_OF_LIGHT_M_S);
     let mut clock_bias_s = 0.0;
     let mut result = None;
@@ -97,13 +102,14 @@ pub fn state_at_transmission(
 }
 
 /// Fills the satellite fields of `obs` (position at transmission in the ECEF frame of
-/// that time, velocity, clock bias with relativistic term and the signal's group delay,
+/// that time, velocity, clock bias with relativistic term and the measurement's group
+/// delay (one signal's, or a combination's, see [`RangingCode`]),
 /// clock drift) from the ephemeris `store` selects for `obs.sat` at the receive time
 /// `t_rx`, using `obs.pseudorange_m` for the travel time.
 pub fn fill_satellite_fields(
     obs: &mut SatObservation,
     store: &EphemerisStore,
-    signal: Signal,
+    code: impl Into<RangingCode>,
     t_rx: &GpsTime,
 ) -> Result<TransmitState, EphemerisError> {
     let sat = obs.sat;
@@ -112,7 +118,7 @@ pub fn fill_satellite_fields(
         week: t_rx.week,
         tow_s: t_rx.tow_s,
     })?;
-    let tx = state_at_transmission(eph, signal, t_rx, obs.pseudorange_m)?;
+    let tx = state_at_transmission(eph, code, t_rx, obs.pseudorange_m)?;
     obs.sat_pos_ecef_m = tx.state.pos_ecef_m;
     obs.sat_vel_ecef_mps = tx.state.vel_ecef_mps;
     obs.sat_clock_bias_s = tx.clock_bias_s;

@@ -16,7 +16,7 @@
 
 use super::header::ObsCode;
 use super::record::{ObsEpoch, SatRecord};
-use crate::gnss::ephemeris::{EphemerisStore, Signal};
+use crate::gnss::ephemeris::{EphemerisStore, RangingCode, Signal};
 use crate::gnss::epoch_build::{
     complete_epoch, preferred_signals, unfilled_observation, BuiltEpoch, EpochStats,
 };
@@ -60,7 +60,7 @@ pub fn build_rinex_epoch(
     let mut candidates = Vec::new();
     for record in records {
         match choose(record) {
-            Some(candidate) => candidates.push(candidate),
+            Some((signal, obs)) => candidates.push((RangingCode::Single(signal), obs)),
             None => stats.unsupported += 1,
         }
     }

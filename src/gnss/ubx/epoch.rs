@@ -2,6 +2,12 @@
 //! broadcast ephemerides.
 //!
 //! Choices (beyond the shared ones of [`crate::gnss::epoch_build`]):
+//! - [`IonosphereMode::IonoFree`]: the ionosphere-free combination of the first pair of
+//!   [`iono_free_pairs`] with both pseudo-ranges valid, σ propagated from both prStdev;
+//!   satellites without one are left out (counted as `single_frequency`). The rate is the
+//!   first signal's Doppler: the ionosphere's rate of change (millimetres per second) is
+//!   left in it. The other modes use one signal per satellite
+//!   ([`crate::gnss::epoch_build::preferred_signals`]).
 //! - Receive time: the RAWX receiver time (week, rcvTow) as GPST, uncorrected for the
 //!   receiver clock (see [`crate::gnss::ephemeris::state_at_transmission`]).
 //! - Rate: ρ̇ = −λ · D (u-blox Doppler is positive for an approaching satellite), σ_ρ̇ =
@@ -9,15 +15,26 @@
 
 use super::ids::{sat_id, signal};
 use super::rawx::{RawMeasurement, RawX};
-use crate::gnss::ephemeris::{EphemerisStore, GpsTime, Signal};
+use crate::gnss::ephemeris::{EphemerisStore, GpsTime, RangingCode, Signal};
 use crate::gnss::epoch_build::{
     complete_epoch, preferred_signals, unfilled_observation, BuiltEpoch, EpochStats,
 };
+use crate::gnss::ionosphere::{iono_free_pairs, IonosphereMode};
 use crate::gnss::{Klobuchar, SatId, SatObservation};
 
-/// Builds the epoch of `raw`: one [`SatObservation`] per satellite with a usable signal
-/// and an ephemeris in `store`; `klobuchar` is passed through.
+/// Builds the single-frequency epoch of `raw` ([`IonosphereMode::Broadcast`]).
 pub fn build_epoch(raw: &RawX, store: &EphemerisStore, klobuchar: Option<Klobuchar>) -> BuiltEpoch {
+    build_epoch_with(raw, store, klobuchar, IonosphereMode::Broadcast)
+}
+
+/// Builds the epoch of `raw`: one [`SatObservation`] per satellite with a usable signal
+/// (or pair, see `mode`) and an ephemeris in `store`; `klobuchar` is passed through.
+pub fn build_epoch_with(
+    raw: &RawX,
+    store: &EphemerisStore,
+    klobuchar: Option<Klobuchar>,
+    mode: IonosphereMode,
+) -> BuiltEpoch {
     let receive_time = GpsTime::new(i32::from(raw.week), raw.rcv_tow_s);
     let mut stats = EpochStats {
         measurements: raw.measurements.len(),
@@ -33,38 +50,88 @@ pub fn build_epoch(raw: &RawX, store: &EphemerisStore, klobuchar: Option<Klobuch
     stats.satellites = sats.len();
     let mut candidates = Vec::new();
     for sat in sats {
-        match choose(raw, sat) {
-            Some((sig, m)) => candidates.push((sig, observation(sat, sig, m))),
+        let chosen = match mode {
+            IonosphereMode::IonoFree => choose_pair(raw, sat),
+            IonosphereMode::Broadcast | IonosphereMode::None => {
+                choose(raw, sat).map(|(sig, m)| (RangingCode::Single(sig), m, None))
+            }
+        };
+        let Some((code, m, second)) = chosen else {
+            // Ionosphere-free mode: a satellite that single-frequency mode would use.
+            let single = mode == IonosphereMode::IonoFree && choose(raw, sat).is_some();
+            match (single, store.select(sat, &receive_time).is_some()) {
+                (true, true) => stats.single_frequency += 1,
+                (true, false) => stats.no_ephemeris += 1,
+                (false, _) => stats.unsupported += 1,
+            }
+            continue;
+        };
+        match observation(sat, code, m, second, mode) {
+            Some(obs) => candidates.push((code, obs)),
             None => stats.unsupported += 1,
         }
     }
     complete_epoch(receive_time, candidates, store, klobuchar, stats)
 }
 
+/// The usable measurement of `sat` on `wanted`.
+fn measurement(raw: &RawX, sat: SatId, wanted: Signal) -> Option<&RawMeasurement> {
+    raw.measurements.iter().find(|m| {
+        sat_id(m.gnss_id, m.sv_id) == Some(sat)
+            && signal(m.gnss_id, m.sig_id) == Some(wanted)
+            && m.tracking.pr_valid
+            && m.pseudorange_m.is_finite()
+            && m.pseudorange_m > 0.0
+    })
+}
+
 /// The preferred usable measurement of `sat`.
 fn choose(raw: &RawX, sat: SatId) -> Option<(Signal, &RawMeasurement)> {
     preferred_signals(sat.constellation)
         .iter()
-        .find_map(|&wanted| {
-            raw.measurements.iter().find_map(|m| {
-                let usable = sat_id(m.gnss_id, m.sv_id) == Some(sat)
-                    && signal(m.gnss_id, m.sig_id) == Some(wanted)
-                    && m.tracking.pr_valid
-                    && m.pseudorange_m.is_finite()
-                    && m.pseudorange_m > 0.0;
-                usable.then_some((wanted, m))
-            })
+        .find_map(|&wanted| measurement(raw, sat, wanted).map(|m| (wanted, m)))
+}
+
+/// The preferred usable ionosphere-free pair of `sat`.
+fn choose_pair(
+    raw: &RawX,
+    sat: SatId,
+) -> Option<(RangingCode, &RawMeasurement, Option<&RawMeasurement>)> {
+    iono_free_pairs(sat.constellation)
+        .iter()
+        .find_map(|&(first, second)| {
+            let m1 = measurement(raw, sat, first)?;
+            let m2 = measurement(raw, sat, second)?;
+            Some((RangingCode::IonoFree { first, second }, m1, Some(m2)))
         })
 }
 
-fn observation(sat: SatId, sig: Signal, m: &RawMeasurement) -> SatObservation {
-    let lambda_m = sig.wavelength_m();
+/// The observation of `code` from its first signal's measurement `m` and, for a
+/// combination, the second's; None if the combination is undefined.
+fn observation(
+    sat: SatId,
+    code: RangingCode,
+    m: &RawMeasurement,
+    second: Option<&RawMeasurement>,
+    mode: IonosphereMode,
+) -> Option<SatObservation> {
+    let lambda_m = code.primary().wavelength_m();
     let finite = |v: f64| v.is_finite().then_some(v);
-    SatObservation {
+    let (pseudorange_m, pseudorange_sigma_m) = code.combine(
+        (m.pseudorange_m, m.pseudorange_sigma_m),
+        second.map(|s| (s.pseudorange_m, s.pseudorange_sigma_m)),
+    )?;
+    // Broadcast: unset, so the engine applies the epoch's Klobuchar model if any.
+    let iono_delay_m = match mode {
+        IonosphereMode::Broadcast => None,
+        IonosphereMode::IonoFree | IonosphereMode::None => Some(0.0),
+    };
+    Some(SatObservation {
         pseudorange_rate_mps: finite(-lambda_m * m.doppler_hz),
-        pseudorange_sigma_m: finite(m.pseudorange_sigma_m),
+        pseudorange_sigma_m: finite(pseudorange_sigma_m),
         pseudorange_rate_sigma_mps: finite(lambda_m * m.doppler_sigma_hz),
         cn0_dbhz: Some(m.cn0_dbhz),
-        ..unfilled_observation(sat, m.pseudorange_m)
-    }
+        iono_delay_m,
+        ..unfilled_observation(sat, pseudorange_m)
+    })
 }

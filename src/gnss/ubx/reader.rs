@@ -2,7 +2,7 @@
 //! built with the ephemerides decoded from the SFRBX messages received before it, as a
 //! real-time receiver would.
 
-use super::epoch::build_epoch;
+use super::epoch::build_epoch_with;
 use super::frame::{FrameReader, FrameStats};
 use super::message::{decode_message, UbxMessage};
 use super::nav_decoder::{NavDecoder, NavDecoderStats, NavUpdate};
@@ -11,6 +11,7 @@ use super::rawx::RawX;
 use super::sfrbx::Sfrbx;
 use crate::gnss::ephemeris::{EphemerisStore, GpsTime};
 use crate::gnss::epoch_build::BuiltEpoch;
+use crate::gnss::ionosphere::IonosphereMode;
 use crate::gnss::Klobuchar;
 
 /// SFRBX messages held while no RAWX has yet given the GPS week.
@@ -55,8 +56,15 @@ pub struct UbxLog {
     pub stats: UbxLogStats,
 }
 
-/// Decodes a UBX byte stream. Never fails: what cannot be used is skipped and counted.
+/// Decodes a UBX byte stream, its epochs built single-frequency
+/// ([`IonosphereMode::Broadcast`]). Never fails: what cannot be used is skipped and
+/// counted.
 pub fn read_ubx_log(bytes: &[u8]) -> UbxLog {
+    read_ubx_log_with(bytes, IonosphereMode::Broadcast)
+}
+
+/// Decodes a UBX byte stream, its epochs built as `ionosphere` says.
+pub fn read_ubx_log_with(bytes: &[u8], ionosphere: IonosphereMode) -> UbxLog {
     let mut log = UbxLog::default();
     let mut decoder = NavDecoder::new();
     let mut reference: Option<GpsTime> = None;
@@ -73,7 +81,7 @@ pub fn read_ubx_log(bytes: &[u8]) -> UbxLog {
                         apply(&mut log, &mut decoder, &msg, &t);
                     }
                 }
-                let built = build_epoch(&raw, &log.store, log.klobuchar);
+                let built = build_epoch_with(&raw, &log.store, log.klobuchar, ionosphere);
                 log.epochs.push(built);
                 log.rawx.push(raw);
             }
