@@ -9,7 +9,7 @@ use adaptive_gnss_ins::config::Config;
 use adaptive_gnss_ins::eval::ErrorSummary;
 use adaptive_gnss_ins::gnss::ionosphere::IonosphereMode;
 use adaptive_gnss_ins::tools::convert::{
-    convert, ConvertOptions, EphemerisMode, ImuInput, ImuTime, TruthInput,
+    convert, ConvertOptions, EphemerisMode, GnssSource, ImuInput, ImuTime, TruthInput,
 };
 use adaptive_gnss_ins::tools::imu_csv::{AccelUnit, GyroUnit, ImuCsvFormat};
 use adaptive_gnss_ins::tools::replay::bag_inputs;
@@ -59,7 +59,7 @@ fn data() -> PathBuf {
 fn options() -> ConvertOptions {
     let d = data();
     ConvertOptions {
-        ubx: d.join("gnss_1730.ubx"),
+        gnss: GnssSource::Ubx(d.join("gnss_1730.ubx")),
         imu: Some(ImuInput {
             csv: d.join("imu_1730.csv"),
             format: ImuCsvFormat::new(

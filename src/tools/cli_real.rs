@@ -7,8 +7,8 @@ use clap::{Args, ValueEnum};
 
 use super::cli::load_config;
 use super::convert::{
-    convert as convert_files, ConvertOptions, ConvertSummary, EphemerisMode, ImuInput, ImuTime,
-    TruthInput,
+    convert as convert_files, ConvertOptions, ConvertSummary, EphemerisMode, GnssSource, ImuInput,
+    ImuTime, TruthInput,
 };
 use super::imu_csv::{AccelUnit, GyroUnit, ImuCsvFormat};
 use super::replay::bag_inputs;
@@ -86,8 +86,18 @@ pub enum EphemerisArg {
 pub struct ConvertArgs {
     /// u-blox UBX log with UBX-RXM-RAWX and UBX-RXM-SFRBX (and UBX-NAV-PVT for
     /// --truth-ubx). RAWX carries GPS time, so the log needs no time tag.
-    #[arg(long)]
-    pub ubx: PathBuf,
+    #[arg(
+        long,
+        required_unless_present = "rinex_obs",
+        conflicts_with = "rinex_obs"
+    )]
+    pub ubx: Option<PathBuf>,
+    /// RINEX 3 observation file (instead of --ubx; single frequency, with --rinex-nav).
+    #[arg(long, requires = "rinex_nav")]
+    pub rinex_obs: Option<PathBuf>,
+    /// RINEX 3 navigation file of --rinex-obs.
+    #[arg(long, requires = "rinex_obs")]
+    pub rinex_nav: Option<PathBuf>,
     /// IMU CSV, one sample per line (see --imu-columns).
     #[arg(long)]
     pub imu_csv: Option<PathBuf>,
@@ -179,8 +189,16 @@ impl ConvertArgs {
             (None, true) => TruthInput::UbxNavPvt,
             (None, false) => TruthInput::None,
         };
+        let gnss = match (&self.ubx, &self.rinex_obs, &self.rinex_nav) {
+            (Some(ubx), None, None) => GnssSource::Ubx(ubx.clone()),
+            (None, Some(obs), Some(nav)) => GnssSource::Rinex {
+                obs: obs.clone(),
+                nav: nav.clone(),
+            },
+            _ => return Err("give either --ubx or --rinex-obs with --rinex-nav".to_owned()),
+        };
         Ok(ConvertOptions {
-            ubx: self.ubx.clone(),
+            gnss,
             imu,
             truth,
             leap_seconds: self.leap_seconds,
@@ -275,7 +293,9 @@ pub fn spp(args: SppArgs) -> Result<(), String> {
     let temp = std::env::temp_dir().join(format!("gnss_ins_spp_{}.mcap", std::process::id()));
     let bag = if is_ubx {
         let convert = ConvertArgs {
-            ubx: args.input.clone(),
+            ubx: Some(args.input.clone()),
+            rinex_obs: None,
+            rinex_nav: None,
             imu_csv: None,
             imu_columns: String::new(),
             imu_accel_unit: AccelUnitArg::G,

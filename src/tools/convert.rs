@@ -26,7 +26,10 @@ use std::path::{Path, PathBuf};
 use nalgebra::Vector3;
 
 use crate::earth::{self, Llh};
+use crate::gnss::ephemeris::EphemerisStore;
 use crate::gnss::ionosphere::IonosphereMode;
+use crate::gnss::rinex_nav::parse_rinex_nav;
+use crate::gnss::rinex_obs::{build_rinex_epoch, parse_rinex_obs};
 use crate::gnss::ubx::{build_epoch_with, read_ubx_log_with, CarrierSolution, NavPvt, UbxLog};
 use crate::ins::ImuSample;
 use crate::ros::bag::{BagError, BagWriter};
@@ -93,10 +96,23 @@ pub enum TruthInput {
     },
 }
 
+/// Where the GNSS measurements come from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum GnssSource {
+    /// A u-blox UBX log: RXM-RAWX measurements with the ephemerides of its RXM-SFRBX
+    /// subframes (and NAV-PVT for a reference).
+    Ubx(PathBuf),
+    /// RINEX 3 observation and navigation files. Choice: single frequency only (the
+    /// first preferred code of each satellite, as the RINEX single-point mode), with the
+    /// navigation header's Klobuchar coefficients when it has them; the
+    /// ionosphere-free mode is refused rather than silently changed.
+    Rinex { obs: PathBuf, nav: PathBuf },
+}
+
 /// What to convert.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ConvertOptions {
-    pub ubx: PathBuf,
+    pub gnss: GnssSource,
     pub imu: Option<ImuInput>,
     pub truth: TruthInput,
     /// GPS − UTC (s).
@@ -118,8 +134,14 @@ pub enum ConvertError {
     ImuCsv { path: String, source: ImuCsvError },
     #[error("{path}: {source}")]
     TimeTag { path: String, source: TimeTagError },
-    #[error("{path}: no UBX-RXM-RAWX epoch with a usable satellite")]
+    #[error("{path}: no epoch with a usable satellite")]
     NoGnss { path: String },
+    #[error("{path}: {message}")]
+    Rinex { path: String, message: String },
+    #[error("RINEX input is single-frequency: use --ionosphere broadcast or none")]
+    RinexIonoFree,
+    #[error("--truth-ubx needs a UBX log as the GNSS input")]
+    TruthNeedsUbx,
     #[error("{path}: no reference solution")]
     NoTruth { path: String },
     #[error("GPST {gpst_s} s is no ROS time")]
@@ -188,22 +210,29 @@ fn stamp_of(gpst_s: f64, leap_s: f64) -> Result<(Time, u64), ConvertError> {
 
 /// Converts the inputs of `options` into the bag `out`.
 pub fn convert(options: &ConvertOptions, out: &Path) -> Result<ConvertSummary, ConvertError> {
-    let ubx_path = options.ubx.display().to_string();
-    let log = read_ubx_log_with(&read(&options.ubx)?, options.ionosphere);
-    let mut summary = ConvertSummary {
-        klobuchar: log.klobuchar.is_some(),
-        receiver_leap_seconds: log
-            .rawx
-            .iter()
-            .rev()
-            .find(|r| r.leap_s_valid)
-            .map(|r| r.leap_s),
-        ..ConvertSummary::default()
-    };
+    let mut summary = ConvertSummary::default();
     let mut items: Vec<(u64, Item)> = Vec::new();
-    gnss_items(&log, options, &mut items, &mut summary)?;
+    let (gnss_path, log) = match &options.gnss {
+        GnssSource::Ubx(path) => {
+            let log = read_ubx_log_with(&read(path)?, options.ionosphere);
+            summary.klobuchar = log.klobuchar.is_some();
+            summary.receiver_leap_seconds = log
+                .rawx
+                .iter()
+                .rev()
+                .find(|r| r.leap_s_valid)
+                .map(|r| r.leap_s);
+            gnss_items(&log, options, &mut items, &mut summary)?;
+            (path, Some(log))
+        }
+        GnssSource::Rinex { obs, nav } => {
+            rinex_items(obs, nav, options, &mut items, &mut summary)?;
+            (obs, None)
+        }
+    };
+    let gnss_path = gnss_path.display().to_string();
     if summary.gnss_epochs == 0 {
-        return Err(ConvertError::NoGnss { path: ubx_path });
+        return Err(ConvertError::NoGnss { path: gnss_path });
     }
     if let Some(imu) = &options.imu {
         imu_items(imu, options.leap_seconds, &mut items, &mut summary)?;
@@ -211,9 +240,10 @@ pub fn convert(options: &ConvertOptions, out: &Path) -> Result<ConvertSummary, C
     let truth = match &options.truth {
         TruthInput::None => Vec::new(),
         TruthInput::UbxNavPvt => {
-            let t = nav_pvt_truth(&log);
+            let log = log.as_ref().ok_or(ConvertError::TruthNeedsUbx)?;
+            let t = nav_pvt_truth(log);
             if t.is_empty() {
-                return Err(ConvertError::NoTruth { path: ubx_path });
+                return Err(ConvertError::NoTruth { path: gnss_path });
             }
             t
         }
@@ -302,6 +332,54 @@ fn gnss_items(
         let gpst = gpst_of_week_tow(i32::from(raw.week), raw.rcv_tow_s);
         let (stamp, ns) = stamp_of(gpst, options.leap_seconds)?;
         let msg = outbound::gnss_measurements(&built.epoch, raw.week, stamp, GNSS_FRAME);
+        summary.gnss_epochs += 1;
+        summary.satellites += built.epoch.satellites.len();
+        items.push((ns, Item::Gnss(Box::new(msg))));
+    }
+    Ok(())
+}
+
+/// The epochs of a RINEX observation file with the ephemerides of its navigation file.
+fn rinex_items(
+    obs_path: &Path,
+    nav_path: &Path,
+    options: &ConvertOptions,
+    items: &mut Vec<(u64, Item)>,
+    summary: &mut ConvertSummary,
+) -> Result<(), ConvertError> {
+    if options.ionosphere == IonosphereMode::IonoFree {
+        return Err(ConvertError::RinexIonoFree);
+    }
+    let text = |p: &Path| read(p).map(|b| String::from_utf8_lossy(&b).into_owned());
+    let rinex_error = |p: &Path, e: &dyn std::fmt::Display| ConvertError::Rinex {
+        path: p.display().to_string(),
+        message: e.to_string(),
+    };
+    let obs = parse_rinex_obs(&text(obs_path)?).map_err(|e| rinex_error(obs_path, &e))?;
+    let nav = parse_rinex_nav(&text(nav_path)?).map_err(|e| rinex_error(nav_path, &e))?;
+    let mut store = EphemerisStore::new();
+    for eph in &nav.ephemerides {
+        store.insert(*eph);
+    }
+    summary.klobuchar = nav.klobuchar.is_some();
+    for epoch in &obs.epochs {
+        let mut built = build_rinex_epoch(epoch, &store, nav.klobuchar);
+        if options.ionosphere == IonosphereMode::None {
+            for sat in &mut built.epoch.satellites {
+                sat.iono_delay_m = Some(0.0);
+            }
+        }
+        let time = built.receive_time;
+        let week = u16::try_from(time.week).ok();
+        let (Some(week), false) = (week, built.epoch.satellites.is_empty()) else {
+            summary.empty_epochs += 1;
+            continue;
+        };
+        let (stamp, ns) = stamp_of(
+            gpst_of_week_tow(time.week, time.tow_s),
+            options.leap_seconds,
+        )?;
+        let msg = outbound::gnss_measurements(&built.epoch, week, stamp, GNSS_FRAME);
         summary.gnss_epochs += 1;
         summary.satellites += built.epoch.satellites.len();
         items.push((ns, Item::Gnss(Box::new(msg))));
