@@ -1,5 +1,6 @@
 //! The `gnss_ins_node` binary over DDS: a second participant publishes a simulated static
-//! receiver and checks the node's Odometry against the truth.
+//! receiver and checks the node's Odometry against the truth, and its `/tf` (run with
+//! `publish_tf` and a `base_frame` of its own) against the Odometry.
 //!
 //! DDS traffic must stay on this machine: each test re-executes itself inside a private
 //! network namespace that has only loopback (`unshare -n`, needs root), where RustDDS
@@ -12,7 +13,9 @@ use std::time::{Duration, Instant};
 
 use adaptive_gnss_ins::earth::{self, Llh};
 use adaptive_gnss_ins::ros::convert::seconds_to_time;
-use adaptive_gnss_ins::ros::msg::{DiagnosticArray, GnssMeasurements, Imu, Odometry, RosMessage};
+use adaptive_gnss_ins::ros::msg::{
+    DiagnosticArray, GnssMeasurements, Imu, Odometry, RosMessage, TFMessage,
+};
 use adaptive_gnss_ins::ros::outbound;
 use adaptive_gnss_ins::sim::{Scenario, SimEvent};
 use netns_support::{reexec_in_private_netns, KillOnDrop};
@@ -50,6 +53,7 @@ fn node_estimates_a_static_receiver() {
         .args(["--ros-args", "--params-file", params])
         .args(["-p", "init.heading_deg:=0.0", "-p", &datum])
         .args(["-r", "__ns:=/test", "-r", "imu:=imu/data"])
+        .args(["-p", "publish_tf:=true", "-p", "base_frame:=imu_link"])
         .env("ROS_DOMAIN_ID", DOMAIN_ID.to_string())
         .env("RUST_LOG", "info,rustdds=error,ros2_client=warn")
         .stdin(Stdio::null())
@@ -80,6 +84,7 @@ fn node_estimates_a_static_receiver() {
     );
     let odom_topic = topic(&mut peer, "/test/odometry", type_name::<Odometry>());
     let diag_topic = topic(&mut peer, "/diagnostics", type_name::<DiagnosticArray>());
+    let tf_topic = topic(&mut peer, "/tf", type_name::<TFMessage>());
     let imu_pub = peer.create_publisher::<Imu>(&imu_topic, None).unwrap();
     let gnss_pub = peer
         .create_publisher::<GnssMeasurements>(&gnss_topic, None)
@@ -90,6 +95,9 @@ fn node_estimates_a_static_receiver() {
     let diag_sub = peer
         .create_subscription::<DiagnosticArray>(&diag_topic, None)
         .unwrap();
+    let tf_sub = peer
+        .create_subscription::<TFMessage>(&tf_topic, None)
+        .unwrap();
     let spinner = peer.spinner().unwrap();
     std::thread::spawn(move || smol::block_on(spinner.spin()));
 
@@ -99,6 +107,7 @@ fn node_estimates_a_static_receiver() {
             imu_pub.wait_for_subscription(&peer).await;
             gnss_pub.wait_for_subscription(&peer).await;
             odom_sub.wait_for_publisher(&peer).await;
+            tf_sub.wait_for_publisher(&peer).await;
             true
         };
         futures::select! {
@@ -182,10 +191,14 @@ fn node_estimates_a_static_receiver() {
     // Collect what the node published.
     let deadline = Instant::now() + Duration::from_secs(3);
     let mut odometry = Vec::new();
+    let mut transforms = Vec::new();
     let mut last_diagnostics = None;
     while Instant::now() < deadline {
         while let Ok(Some((o, _))) = odom_sub.take() {
             odometry.push(o);
+        }
+        while let Ok(Some((t, _))) = tf_sub.take() {
+            transforms.extend(t.transforms);
         }
         while let Ok(Some((d, _))) = diag_sub.take() {
             last_diagnostics = Some(d);
@@ -208,8 +221,36 @@ fn node_estimates_a_static_receiver() {
             "non-finite Odometry {o:?}"
         );
         assert_eq!(o.header.frame_id, "map");
-        assert_eq!(o.child_frame_id, "base_link");
+        assert_eq!(o.child_frame_id, "imu_link");
     }
+    // /tf: map -> imu_link at each Odometry's stamp, translated to its position.
+    assert!(
+        transforms.len() > 5000,
+        "only {} transforms received",
+        transforms.len()
+    );
+    let mut matched = 0;
+    for t in &transforms {
+        assert_eq!(t.header.frame_id, "map");
+        assert_eq!(t.child_frame_id, "imu_link");
+        if let Some(o) = odometry.iter().find(|o| o.header.stamp == t.header.stamp) {
+            let p = &o.pose.pose.position;
+            let tr = &t.transform.translation;
+            assert_eq!(
+                [tr.x, tr.y, tr.z],
+                [p.x, p.y, p.z],
+                "at {:?}",
+                t.header.stamp
+            );
+            assert_eq!(t.transform.rotation, o.pose.pose.orientation);
+            matched += 1;
+        }
+    }
+    eprintln!(
+        "{} transforms, {matched} matched to an Odometry",
+        transforms.len()
+    );
+    assert!(matched > 5000, "{matched} transforms matched an Odometry");
     let last = odometry.last().unwrap();
     let p = &last.pose.pose.position;
     let truth_enu = earth::llh_to_enu(&truth, &truth);

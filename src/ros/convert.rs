@@ -4,9 +4,9 @@
 //! vectors stay in the IMU's own frame (`header.frame_id`); the engine rotates them into
 //! the body frame from the configured mounting.
 
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 
-use super::msg::{GnssMeasurements, Imu, SatelliteMeasurement, Time};
+use super::msg::{GnssMeasurements, Imu, SatelliteMeasurement, Time, TwistWithCovarianceStamped};
 use crate::gnss::{Constellation, GnssEpoch, Klobuchar, SatId, SatObservation};
 use crate::ins::ImuSample;
 
@@ -76,6 +76,62 @@ pub enum ConvertError {
         /// The rejected vector (x, y, z).
         value: [f64; 3],
     },
+    /// A GNSS velocity with a NaN or infinite linear part or linear covariance.
+    #[error("GNSS velocity at {t_s} s: {field} is not finite")]
+    NonFiniteVelocity {
+        /// Stamp of the velocity (s).
+        t_s: f64,
+        /// Name of the field in `geometry_msgs/TwistWithCovariance`.
+        field: &'static str,
+    },
+}
+
+/// A receiver's velocity (`gnss/velocity`), waiting to join the fix of its stamp.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GnssVelocity {
+    /// Stamp (s).
+    pub t_s: f64,
+    /// `header.frame_id`.
+    pub frame_id: String,
+    /// Antenna velocity in ENU (m/s).
+    pub velocity_enu_mps: Vector3<f64>,
+    /// Its covariance ((m/s)²); None when the message gives none.
+    pub covariance_enu_m2_s2: Option<Matrix3<f64>>,
+}
+
+impl TryFrom<&TwistWithCovarianceStamped> for GnssVelocity {
+    type Error = ConvertError;
+
+    /// Convention (REP-105 and the GNSS drivers, e.g. ublox_gps's `fix_velocity`): the
+    /// twist's linear part is the antenna velocity along east, north, up; the angular part
+    /// is ignored. Choice: a covariance whose linear block is all zero or starts with −1
+    /// (sensor_msgs' "unknown") is none, and the configured σ applies.
+    fn try_from(msg: &TwistWithCovarianceStamped) -> Result<Self, Self::Error> {
+        let t_s = time_to_seconds(&msg.header.stamp)?;
+        let v = &msg.twist.twist.linear;
+        let velocity = Vector3::new(v.x, v.y, v.z);
+        if !velocity.iter().all(|c| c.is_finite()) {
+            return Err(ConvertError::NonFiniteVelocity {
+                t_s,
+                field: "twist.linear",
+            });
+        }
+        let c = &msg.twist.covariance;
+        let block = Matrix3::from_fn(|r, k| c[6 * r + k]);
+        if !block.iter().all(|x| x.is_finite()) {
+            return Err(ConvertError::NonFiniteVelocity {
+                t_s,
+                field: "covariance",
+            });
+        }
+        let unknown = block.iter().all(|x| *x == 0.0) || block[(0, 0)] == -1.0;
+        Ok(Self {
+            t_s,
+            frame_id: msg.header.frame_id.clone(),
+            velocity_enu_mps: velocity,
+            covariance_enu_m2_s2: (!unknown).then_some(block),
+        })
+    }
 }
 
 /// Seconds of a ROS stamp as `f64`: `sec + nanosec / 1e9`.
@@ -614,6 +670,55 @@ mod tests {
             ImuSample::try_from(&imu),
             Err(ConvertError::NonFiniteImu {
                 field: "linear_acceleration",
+                ..
+            })
+        ));
+    }
+
+    #[test]
+    fn gnss_velocity_is_the_linear_twist_in_enu() {
+        let mut msg = TwistWithCovarianceStamped::default();
+        msg.header.stamp = Time {
+            sec: 7,
+            nanosec: 250_000_000,
+        };
+        msg.header.frame_id = "map".to_owned();
+        msg.twist.twist.linear.x = 1.5;
+        msg.twist.twist.linear.y = -2.0;
+        msg.twist.twist.angular.z = 9.0;
+        let v = GnssVelocity::try_from(&msg).unwrap();
+        assert_eq!(v.t_s, 7.25);
+        assert_eq!(v.frame_id, "map");
+        assert_eq!(v.velocity_enu_mps, Vector3::new(1.5, -2.0, 0.0));
+        assert_eq!(v.covariance_enu_m2_s2, None, "all-zero covariance: unknown");
+        msg.twist.covariance[0] = 0.04;
+        msg.twist.covariance[7] = 0.09;
+        msg.twist.covariance[14] = 0.16;
+        msg.twist.covariance[21] = 5.0; // angular: ignored
+        let c = GnssVelocity::try_from(&msg)
+            .unwrap()
+            .covariance_enu_m2_s2
+            .unwrap();
+        assert_eq!(c, Matrix3::from_diagonal(&Vector3::new(0.04, 0.09, 0.16)));
+        msg.twist.covariance[0] = -1.0;
+        assert_eq!(
+            GnssVelocity::try_from(&msg).unwrap().covariance_enu_m2_s2,
+            None
+        );
+        msg.twist.covariance[8] = f64::NAN;
+        assert!(matches!(
+            GnssVelocity::try_from(&msg),
+            Err(ConvertError::NonFiniteVelocity {
+                field: "covariance",
+                ..
+            })
+        ));
+        msg.twist.covariance[8] = 0.0;
+        msg.twist.twist.linear.z = f64::INFINITY;
+        assert!(matches!(
+            GnssVelocity::try_from(&msg),
+            Err(ConvertError::NonFiniteVelocity {
+                field: "twist.linear",
                 ..
             })
         ));

@@ -1,6 +1,7 @@
 //! Core types to ROS messages: the engine's outputs as nav_msgs/Odometry (REP-103/105: pose in a local ENU
-//! frame at the datum, twist in the body frame), sensor_msgs/NavSatFix and our
-//! NoiseEstimates (the covariance-diagnostic topic); and simulated inputs as Imu,
+//! frame at the datum, twist in the body frame), its TF (tf2_msgs/TFMessage),
+//! sensor_msgs/NavSatFix and our NoiseEstimates (the covariance-diagnostic topic); and
+//! simulated inputs as Imu,
 //! GnssMeasurements and NavSatFix (for writing bags).
 
 use nalgebra::{Matrix3, SMatrix};
@@ -11,8 +12,8 @@ use crate::ins::error_state::{DV, GYRO_BIAS, GYRO_GM};
 
 use super::msg::{
     GnssMeasurements, Header, Imu, NavSatFix, NavSatStatus, NoiseEstimates, Odometry, Point, Pose,
-    PoseWithCovariance, Quaternion, SatelliteMeasurement, SatelliteNoise, Time, Twist,
-    TwistWithCovariance, Vector3,
+    PoseWithCovariance, Quaternion, SatelliteMeasurement, SatelliteNoise, TFMessage, Time,
+    Transform, TransformStamped, Twist, TwistWithCovariance, Vector3,
 };
 
 fn vector3(v: &nalgebra::Vector3<f64>) -> Vector3 {
@@ -88,6 +89,27 @@ pub fn odometry(
             },
             covariance: row_major_6(&twist_cov),
         },
+    }
+}
+
+/// The `/tf` message of an Odometry: the transform from its `header.frame_id` to its
+/// `child_frame_id` at its stamp, translation its position and rotation its orientation
+/// (the pose of the body in the map frame is exactly the map → body transform).
+pub fn transform(odometry: &Odometry) -> TFMessage {
+    let pose = &odometry.pose.pose;
+    TFMessage {
+        transforms: vec![TransformStamped {
+            header: odometry.header.clone(),
+            child_frame_id: odometry.child_frame_id.clone(),
+            transform: Transform {
+                translation: Vector3 {
+                    x: pose.position.x,
+                    y: pose.position.y,
+                    z: pose.position.z,
+                },
+                rotation: pose.orientation,
+            },
+        }],
     }
 }
 
@@ -315,6 +337,36 @@ mod tests {
         assert_eq!(
             fix.position_covariance_type,
             NavSatFix::COVARIANCE_TYPE_KNOWN
+        );
+    }
+
+    #[test]
+    fn transform_is_the_odometry_pose_between_its_frames() {
+        let (sol, datum) = solution();
+        let stamp = Time {
+            sec: 12,
+            nanosec: 500_000_000,
+        };
+        let odom = odometry(&sol, &datum, stamp, "world", "imu_link");
+        let tf = transform(&odom);
+        assert_eq!(tf.transforms.len(), 1);
+        let t = &tf.transforms[0];
+        assert_eq!(t.header.stamp, stamp);
+        assert_eq!(t.header.frame_id, "world");
+        assert_eq!(t.child_frame_id, "imu_link");
+        let p = &t.transform.translation;
+        assert!((p.x - 10.0).abs() < 1e-6 && (p.y + 3.0).abs() < 1e-6 && (p.z - 1.0).abs() < 1e-6);
+        let o = &odom.pose.pose.position;
+        assert_eq!([p.x, p.y, p.z], [o.x, o.y, o.z]);
+        // Rotation: body x (forward) points north in the map, as the solution faces north.
+        let r = &t.transform.rotation;
+        let q = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
+            r.w, r.x, r.y, r.z,
+        ));
+        let forward = q * nalgebra::Vector3::x();
+        assert!(
+            (forward - nalgebra::Vector3::y()).norm() < 1e-12,
+            "{forward}"
         );
     }
 }

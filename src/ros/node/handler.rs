@@ -5,20 +5,17 @@ use crate::config::Config;
 use crate::earth::Llh;
 use crate::engine::{Engine, NotRuntimeTunable, Output, ResetReason, StatusEvent};
 use crate::ins::ImuSample;
-use crate::ros::convert::{seconds_to_time, time_to_seconds};
+use crate::ros::convert::{seconds_to_time, time_to_seconds, GnssVelocity};
 use crate::ros::msg::{
     DiagnosticArray, DiagnosticStatus, GnssMeasurements, Header, Imu, KeyValue, NavSatFix,
-    NoiseEstimates, Odometry, Time,
+    NoiseEstimates, Odometry, TFMessage, Time, TwistWithCovarianceStamped,
 };
 use crate::ros::outbound;
 use crate::tools::bag_inputs::fix_of;
 
+use super::fix_pairing::{FixPairing, FramedFix, Released};
 use super::log_limit::LogLimiter;
-
-/// Frame of the odometry pose (local ENU at the datum).
-pub const MAP_FRAME: &str = "map";
-/// Frame of the vehicle body (FLU).
-pub const BODY_FRAME: &str = "base_link";
+use super::params::OutputFrames;
 
 /// Choice: an IMU stamp more than this much older than the last accepted one is a time
 /// jump (a bag played in a loop) and resets the filter; smaller steps back are ordinary
@@ -34,6 +31,8 @@ pub enum OutMsg {
     Fix(NavSatFix),
     /// On `~/noise_estimates`.
     Noise(NoiseEstimates),
+    /// On `/tf` (only with `publish_tf`).
+    Tf(TFMessage),
 }
 
 /// The node's input streams.
@@ -42,6 +41,7 @@ enum Input {
     Imu,
     Gnss,
     Fix,
+    Velocity,
 }
 
 impl Input {
@@ -50,6 +50,7 @@ impl Input {
             Input::Imu => "imu",
             Input::Gnss => "gnss/measurements",
             Input::Fix => "gnss/fix",
+            Input::Velocity => "gnss/velocity",
         }
     }
 }
@@ -63,6 +64,10 @@ pub struct InputCounts {
     pub gnss_received: u64,
     /// NavSatFix messages decoded.
     pub fix_received: u64,
+    /// TwistWithCovarianceStamped messages decoded on `gnss/velocity`.
+    pub velocity_received: u64,
+    /// Velocities fed to the engine with their fix.
+    pub velocity_paired: u64,
     /// Payloads that did not decode, any topic.
     pub undecodable: u64,
     /// IMU messages that decoded but did not convert (bad stamp, NaN).
@@ -71,6 +76,8 @@ pub struct InputCounts {
     pub unconvertible_gnss: u64,
     /// NavSatFix messages without a solution or with a bad stamp.
     pub unconvertible_fix: u64,
+    /// Velocities with a bad stamp or a non-finite value.
+    pub unconvertible_velocity: u64,
     /// Resets because the IMU time jumped backwards.
     pub time_jump_resets: u64,
     /// Outputs not published because a value was not finite.
@@ -81,6 +88,8 @@ pub struct InputCounts {
     pub foreign_frame_gnss: u64,
     /// NavSatFix messages from another frame than the first accepted one.
     pub foreign_frame_fix: u64,
+    /// Velocities neither in the map frame nor in their fix's frame (fix used without).
+    pub foreign_frame_velocity: u64,
 }
 
 /// The `header.frame_id` a stream is locked to.
@@ -115,11 +124,13 @@ pub struct NodeCore {
     imu_frame: FrameLock,
     gnss_frame: FrameLock,
     fix_frame: FrameLock,
+    frames: OutputFrames,
+    pairing: FixPairing,
 }
 
 impl NodeCore {
-    /// A node core running `config`.
-    pub fn new(config: Config) -> Self {
+    /// A node core running `config`, publishing in `frames`.
+    pub fn new(config: Config, frames: OutputFrames) -> Self {
         let datum = config.output.datum;
         Self {
             engine: Engine::new(config),
@@ -129,6 +140,8 @@ impl NodeCore {
             imu_frame: FrameLock::default(),
             gnss_frame: FrameLock::default(),
             fix_frame: FrameLock::default(),
+            frames,
+            pairing: FixPairing::default(),
         }
     }
 
@@ -179,8 +192,11 @@ impl NodeCore {
                     self.engine
                         .reset(sample.t_s, ResetReason::TimeJumpBackwards),
                 );
+                self.pairing.clear();
             }
         }
+        let released = self.pairing.on_time(sample.t_s);
+        outputs.extend(self.push_fixes(released));
         match self.engine.push_imu(&sample) {
             Ok(o) => {
                 self.imu_frame.accepted(&msg.header.frame_id);
@@ -226,18 +242,61 @@ impl NodeCore {
         if !self.fix_frame.admits(&msg.header.frame_id) {
             return self.foreign_frame(Input::Fix, &msg.header.frame_id);
         }
-        let fix = fix_of(msg, t_s);
-        let outputs = match self.engine.push_fix(fix) {
-            Ok(o) => {
-                self.fix_frame.accepted(&msg.header.frame_id);
-                o
-            }
-            Err(e) => {
-                self.log.warn(e.reason.name(), &format!("fix: {e}"));
-                Vec::new()
-            }
-        };
+        let released = self.pairing.on_fix(FramedFix {
+            fix: fix_of(msg, t_s),
+            frame_id: msg.header.frame_id.clone(),
+        });
+        let outputs = self.push_fixes(released);
         self.publishable(outputs)
+    }
+
+    /// Handles one velocity on `gnss/velocity` (loose coupling): it joins the fix of its
+    /// stamp (see [`super::fix_pairing`]).
+    ///
+    /// Convention: the twist is the ENU velocity (REP-105) when `header.frame_id` is the
+    /// map frame; a velocity in its fix's frame (what GNSS drivers such as ublox_gps send)
+    /// is read as ENU too. Any other frame is counted and the fix goes on without it.
+    pub fn on_velocity(&mut self, msg: &TwistWithCovarianceStamped) -> Vec<OutMsg> {
+        self.counts.velocity_received += 1;
+        let velocity = match GnssVelocity::try_from(msg) {
+            Ok(v) => v,
+            Err(e) => return self.unconvertible(Input::Velocity, &e.to_string()),
+        };
+        let released = self.pairing.on_velocity(velocity);
+        let outputs = self.push_fixes(released);
+        self.publishable(outputs)
+    }
+
+    /// Velocities dropped for want of a fix of their stamp.
+    pub fn unpaired_velocities(&self) -> u64 {
+        self.pairing.unpaired_velocities()
+    }
+
+    /// Feeds released fixes (with their velocity when its frame is admissible).
+    fn push_fixes(&mut self, released: Vec<Released>) -> Vec<Output> {
+        let mut outputs = Vec::new();
+        for Released { fix, velocity } in released {
+            let FramedFix { mut fix, frame_id } = fix;
+            if let Some(v) = velocity {
+                if v.frame_id == self.frames.map_frame || v.frame_id == frame_id {
+                    self.counts.velocity_paired += 1;
+                    fix.velocity_enu_mps = Some(v.velocity_enu_mps);
+                    fix.velocity_covariance_enu_m2_s2 = v.covariance_enu_m2_s2;
+                } else {
+                    self.foreign_frame(Input::Velocity, &v.frame_id);
+                }
+            }
+            match self.engine.push_fix(fix) {
+                Ok(o) => {
+                    self.fix_frame.accepted(&frame_id);
+                    outputs.extend(o);
+                }
+                Err(e) => {
+                    self.log.warn(e.reason.name(), &format!("fix: {e}"));
+                }
+            }
+        }
+        outputs
     }
 
     fn unconvertible(&mut self, input: Input, error: &str) -> Vec<OutMsg> {
@@ -245,6 +304,7 @@ impl NodeCore {
             Input::Imu => &mut self.counts.unconvertible_imu,
             Input::Gnss => &mut self.counts.unconvertible_gnss,
             Input::Fix => &mut self.counts.unconvertible_fix,
+            Input::Velocity => &mut self.counts.unconvertible_velocity,
         };
         *counter += 1;
         let name = input.name();
@@ -255,18 +315,23 @@ impl NodeCore {
         Vec::new()
     }
 
+    /// Counts and logs a message from another frame than `expected`.
     fn foreign_frame(&mut self, input: Input, frame_id: &str) -> Vec<OutMsg> {
-        let (counter, lock) = match input {
-            Input::Imu => (&mut self.counts.foreign_frame_imu, &self.imu_frame),
-            Input::Gnss => (&mut self.counts.foreign_frame_gnss, &self.gnss_frame),
-            Input::Fix => (&mut self.counts.foreign_frame_fix, &self.fix_frame),
+        let lock = |l: &FrameLock| format!("`{}`", l.0.clone().unwrap_or_default());
+        let (counter, expected) = match input {
+            Input::Imu => (&mut self.counts.foreign_frame_imu, lock(&self.imu_frame)),
+            Input::Gnss => (&mut self.counts.foreign_frame_gnss, lock(&self.gnss_frame)),
+            Input::Fix => (&mut self.counts.foreign_frame_fix, lock(&self.fix_frame)),
+            Input::Velocity => (
+                &mut self.counts.foreign_frame_velocity,
+                format!("`{}` (ENU) or its fix's frame", self.frames.map_frame),
+            ),
         };
         *counter += 1;
-        let locked = lock.0.clone().unwrap_or_default();
         let name = input.name();
         self.log.warn(
             &format!("foreign frame {name}"),
-            &format!("dropped a message on {name} from frame `{frame_id}`: the node follows `{locked}` (a second publisher?)"),
+            &format!("dropped a message on {name} from frame `{frame_id}`: the node follows {expected} (a second publisher?)"),
         );
         Vec::new()
     }
@@ -281,9 +346,13 @@ impl NodeCore {
                         continue;
                     };
                     let datum = *self.datum.get_or_insert(sol.nav.p);
-                    let odom = outbound::odometry(&sol, &datum, stamp, MAP_FRAME, BODY_FRAME);
-                    let fix = outbound::nav_sat_fix(&sol, stamp, BODY_FRAME);
+                    let f = &self.frames;
+                    let odom = outbound::odometry(&sol, &datum, stamp, &f.map_frame, &f.base_frame);
+                    let fix = outbound::nav_sat_fix(&sol, stamp, &f.base_frame);
                     if odometry_is_finite(&odom) && fix_is_finite(&fix) {
+                        if f.publish_tf {
+                            msgs.push(OutMsg::Tf(outbound::transform(&odom)));
+                        }
                         msgs.push(OutMsg::Odometry(Box::new(odom)));
                         msgs.push(OutMsg::Fix(fix));
                     } else {
@@ -297,7 +366,9 @@ impl NodeCore {
                 Output::Epoch(report) => {
                     if let Ok(stamp) = seconds_to_time(report.t_s) {
                         msgs.push(OutMsg::Noise(outbound::noise_estimates(
-                            &report, stamp, BODY_FRAME,
+                            &report,
+                            stamp,
+                            &self.frames.base_frame,
                         )));
                     }
                 }
@@ -334,15 +405,26 @@ impl NodeCore {
             ("imu_received", c.imu_received.to_string()),
             ("gnss_received", c.gnss_received.to_string()),
             ("fix_received", c.fix_received.to_string()),
+            ("velocity_received", c.velocity_received.to_string()),
+            ("velocity_paired", c.velocity_paired.to_string()),
+            ("unpaired_velocity", self.unpaired_velocities().to_string()),
             ("undecodable", c.undecodable.to_string()),
             ("unconvertible_imu", c.unconvertible_imu.to_string()),
             ("unconvertible_gnss", c.unconvertible_gnss.to_string()),
             ("unconvertible_fix", c.unconvertible_fix.to_string()),
+            (
+                "unconvertible_velocity",
+                c.unconvertible_velocity.to_string(),
+            ),
             ("time_jump_resets", c.time_jump_resets.to_string()),
             ("non_finite_outputs", c.non_finite_outputs.to_string()),
             ("foreign_frame_imu", c.foreign_frame_imu.to_string()),
             ("foreign_frame_gnss", c.foreign_frame_gnss.to_string()),
             ("foreign_frame_fix", c.foreign_frame_fix.to_string()),
+            (
+                "foreign_frame_velocity",
+                c.foreign_frame_velocity.to_string(),
+            ),
         ]
         .into_iter()
         .map(|(key, value)| KeyValue {
@@ -429,6 +511,7 @@ fn fix_is_finite(f: &NavSatFix) -> bool {
 mod tests {
     use super::*;
     use crate::engine::RejectionReason;
+    use nalgebra::Matrix3;
 
     fn imu_at(t_s: f64) -> Imu {
         let sample = ImuSample {
@@ -457,7 +540,7 @@ mod tests {
 
     #[test]
     fn time_jump_backwards_resets_small_steps_are_rejected() {
-        let mut core = NodeCore::new(Config::default());
+        let mut core = NodeCore::new(Config::default(), OutputFrames::default());
         feed(&mut core, 100.0, 102.0);
         core.on_imu(&imu_at(101.5));
         assert_eq!(core.counts().time_jump_resets, 0);
@@ -483,7 +566,7 @@ mod tests {
 
     #[test]
     fn bad_inputs_are_counted_and_dropped() {
-        let mut core = NodeCore::new(Config::default());
+        let mut core = NodeCore::new(Config::default(), OutputFrames::default());
         feed(&mut core, 10.0, 10.5);
         let mut nan = imu_at(10.5);
         nan.linear_acceleration.y = f64::NAN;
@@ -510,7 +593,7 @@ mod tests {
 
     #[test]
     fn a_second_imu_frame_is_counted_and_dropped() {
-        let mut core = NodeCore::new(Config::default());
+        let mut core = NodeCore::new(Config::default(), OutputFrames::default());
         feed(&mut core, 10.0, 10.5);
         let mut other = imu_at(10.505);
         other.header.frame_id = "other_imu".to_owned();
@@ -538,9 +621,10 @@ mod tests {
         let mut config = Config::from_yaml_str(&text, path).unwrap();
         // The static scenario faces north (ENU yaw 90 deg); heading is not observable at rest.
         config.set_parameter("init.heading_deg", "0.0").unwrap();
-        let mut core = NodeCore::new(config);
+        let mut core = NodeCore::new(config, OutputFrames::default());
         let scenario = Scenario::builtin("static", 5).unwrap();
         let (mut odometry, mut epochs) = (0, 0);
+        let mut out_had_tf = false;
         for event in scenario.events() {
             let event = event.unwrap();
             if event.t_s() > 30.0 {
@@ -560,8 +644,11 @@ mod tests {
                 .iter()
                 .filter(|m| matches!(m, OutMsg::Odometry(_)))
                 .count();
+            out_had_tf |= out.iter().any(|m| matches!(m, OutMsg::Tf(_)));
         }
         assert!(odometry > 2000, "{odometry} odometry messages in 30 s");
+        assert_eq!(core.counts().velocity_received, 0);
+        assert!(!out_had_tf, "no /tf without publish_tf");
         assert_eq!(core.engine().init_phase(), None, "running");
         assert_eq!(core.counts().unconvertible_fix, 0);
         assert_eq!(
@@ -570,5 +657,171 @@ mod tests {
                 .count(RejectionReason::WrongCoupling),
             epochs
         );
+    }
+
+    fn loose_core(frames: OutputFrames) -> NodeCore {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/params/ekf_loose.yaml");
+        let text = std::fs::read_to_string(path).unwrap();
+        let mut config = Config::from_yaml_str(&text, path).unwrap();
+        // The static scenario faces north; heading is not observable at rest.
+        config.set_parameter("init.heading_deg", "0.0").unwrap();
+        NodeCore::new(config, frames)
+    }
+
+    /// The velocity message of a simulated fix (ENU twist, the linear covariance block).
+    fn velocity_of(fix: &crate::engine::GnssFix, frame_id: &str) -> TwistWithCovarianceStamped {
+        let mut msg = TwistWithCovarianceStamped::default();
+        msg.header.stamp = seconds_to_time(fix.t_s).unwrap();
+        msg.header.frame_id = frame_id.to_owned();
+        let v = fix.velocity_enu_mps.unwrap();
+        let l = &mut msg.twist.twist.linear;
+        (l.x, l.y, l.z) = (v[0], v[1], v[2]);
+        let c = fix.velocity_covariance_enu_m2_s2.unwrap();
+        for r in 0..3 {
+            for k in 0..3 {
+                msg.twist.covariance[6 * r + k] = c[(r, k)];
+            }
+        }
+        msg
+    }
+
+    #[test]
+    fn velocities_pair_with_their_fixes_bad_ones_are_counted_and_tf_follows_odometry() {
+        use crate::sim::{Scenario, SimEvent};
+        let frames = OutputFrames {
+            map_frame: "map".to_owned(),
+            base_frame: "imu_link".to_owned(),
+            publish_tf: true,
+        };
+        let mut core = loose_core(frames);
+        let scenario = Scenario::builtin("static", 5).unwrap();
+        let mut out = Vec::new();
+        let (mut fixes, mut paired) = (0, 0);
+        for event in scenario.events() {
+            let event = event.unwrap();
+            if event.t_s() > 30.0 {
+                break;
+            }
+            let stamp = seconds_to_time(event.t_s()).unwrap();
+            match event {
+                SimEvent::Imu(s) => out.extend(core.on_imu(&outbound::imu(&s, stamp, "imu"))),
+                SimEvent::Fix(f) => {
+                    fixes += 1;
+                    let fix = outbound::receiver_fix(&f, stamp, "gnss");
+                    // Velocity in the map frame or in the fix's frame, before or after.
+                    let mut velocity = velocity_of(&f, ["map", "gnss"][fixes % 2]);
+                    match fixes {
+                        3 => velocity.twist.twist.linear.x = f64::NAN,
+                        5 => velocity.header.frame_id = "base_link".to_owned(),
+                        _ => paired += 1,
+                    }
+                    if fixes % 2 == 1 {
+                        out.extend(core.on_velocity(&velocity));
+                        out.extend(core.on_fix(&fix));
+                    } else {
+                        out.extend(core.on_fix(&fix));
+                        out.extend(core.on_velocity(&velocity));
+                    }
+                    if fixes == 7 {
+                        // A velocity whose fix never comes, and one repeated after its fix.
+                        let mut late = velocity.clone();
+                        late.header.stamp = seconds_to_time(f.t_s + 0.5).unwrap();
+                        out.extend(core.on_velocity(&velocity));
+                        out.extend(core.on_velocity(&late));
+                    }
+                }
+                _ => {}
+            }
+        }
+        let c = core.counts();
+        assert!(fixes > 25, "{fixes} fixes");
+        assert_eq!(c.velocity_received, fixes as u64 + 2);
+        assert_eq!(c.velocity_paired, paired);
+        assert_eq!(c.unconvertible_velocity, 1, "NaN");
+        assert_eq!(c.foreign_frame_velocity, 1);
+        assert_eq!(core.unpaired_velocities(), 2, "repeated and fix-less");
+        assert_eq!(diagnostic(&core, "unpaired_velocity").as_deref(), Some("2"));
+        assert_eq!(
+            diagnostic(&core, "velocity_paired"),
+            Some(paired.to_string())
+        );
+        let counters = core.engine().counters();
+        for reason in [
+            RejectionReason::MeasurementDuplicate,
+            RejectionReason::FixNotFinite,
+            RejectionReason::MeasurementTooOld,
+        ] {
+            assert_eq!(counters.count(reason), 0, "{reason:?}");
+        }
+        assert_eq!(core.engine().init_phase(), None, "running");
+        // Every Odometry comes with its TF: same stamp, frames, translation and rotation.
+        let mut tf_count = 0;
+        for pair in out.windows(2) {
+            if let [OutMsg::Tf(tf), OutMsg::Odometry(o)] = pair {
+                tf_count += 1;
+                let t = &tf.transforms[0];
+                assert_eq!(t.header, o.header);
+                assert_eq!(
+                    (t.header.frame_id.as_str(), t.child_frame_id.as_str()),
+                    ("map", "imu_link")
+                );
+                let p = &o.pose.pose.position;
+                let tr = &t.transform.translation;
+                assert_eq!([tr.x, tr.y, tr.z], [p.x, p.y, p.z]);
+                assert_eq!(t.transform.rotation, o.pose.pose.orientation);
+            }
+        }
+        let odometry = out
+            .iter()
+            .filter(|m| matches!(m, OutMsg::Odometry(_)))
+            .count();
+        assert!(
+            odometry > 2000 && tf_count == odometry,
+            "{tf_count} TF, {odometry} odometry"
+        );
+    }
+
+    #[test]
+    fn a_paired_velocity_reaches_the_filter() {
+        use crate::sim::{Scenario, SimEvent};
+        // The receiver at rest claims 1 m/s east with σ 0.05 m/s: the filter must follow it.
+        let speed_after = |bias_mps: f64| {
+            let mut core = loose_core(OutputFrames::default());
+            let mut last = None;
+            for event in Scenario::builtin("static", 5).unwrap().events() {
+                let event = event.unwrap();
+                if event.t_s() > 30.0 {
+                    break;
+                }
+                let stamp = seconds_to_time(event.t_s()).unwrap();
+                let out = match event {
+                    SimEvent::Imu(s) => core.on_imu(&outbound::imu(&s, stamp, "imu")),
+                    SimEvent::Fix(mut f) => {
+                        let mut out = core.on_fix(&outbound::receiver_fix(&f, stamp, "gnss"));
+                        f.velocity_enu_mps = Some(nalgebra::Vector3::new(bias_mps, 0.0, 0.0));
+                        f.velocity_covariance_enu_m2_s2 =
+                            Some(Matrix3::identity() * 0.05f64.powi(2));
+                        out.extend(core.on_velocity(&velocity_of(&f, "map")));
+                        out
+                    }
+                    _ => Vec::new(),
+                };
+                for m in out {
+                    if let OutMsg::Odometry(o) = m {
+                        let v = &o.twist.twist.linear;
+                        last = Some(nalgebra::Vector3::new(v.x, v.y, v.z).norm());
+                    }
+                }
+            }
+            assert!(core.counts().velocity_paired > 25);
+            last.unwrap()
+        };
+        let honest = speed_after(0.0);
+        let biased = speed_after(1.0);
+        eprintln!(
+            "speed after 30 s: {honest:.3} m/s at rest, {biased:.3} m/s with the 1 m/s claim"
+        );
+        assert!(honest < 0.1, "at rest: {honest} m/s");
+        assert!(biased > 0.5, "following the claimed 1 m/s: {biased} m/s");
     }
 }

@@ -11,9 +11,11 @@ pub enum Stream {
     Gnss,
     /// `gnss/fix`.
     Fix,
+    /// `gnss/velocity`.
+    Velocity,
 }
 
-const STREAMS: [Stream; 3] = [Stream::Imu, Stream::Gnss, Stream::Fix];
+const STREAMS: [Stream; 4] = [Stream::Imu, Stream::Gnss, Stream::Fix, Stream::Velocity];
 
 impl Stream {
     fn index(self) -> usize {
@@ -25,6 +27,7 @@ impl Stream {
             Stream::Imu => "imu",
             Stream::Gnss => "gnss",
             Stream::Fix => "fix",
+            Stream::Velocity => "velocity",
         }
     }
 }
@@ -37,10 +40,10 @@ pub const IMU_STALE_S: f64 = 1.0;
 /// Arrival counts and times of every message (decodable or not) per stream.
 #[derive(Debug, Clone, Default)]
 pub struct InputStats {
-    count: [u64; 3],
-    last_s: [Option<f64>; 3],
+    count: [u64; 4],
+    last_s: [Option<f64>; 4],
     /// Node time and counts at the previous report.
-    previous_report: Option<(f64, [u64; 3])>,
+    previous_report: Option<(f64, [u64; 4])>,
 }
 
 fn key_value(key: String, value: String) -> KeyValue {

@@ -2,12 +2,14 @@
 //!
 //! Topics (relative, so `__ns` and remappings apply): subscribes `imu`
 //! (sensor_msgs/Imu), `gnss/measurements` (GnssMeasurements), `gnss/fix` (NavSatFix),
-//! `/clock` (rosgraph_msgs/Clock, for `use_sim_time`); publishes `odometry`
-//! (nav_msgs/Odometry, `map` → `base_link`), `fix` (NavSatFix), `~/noise_estimates`
-//! (NoiseEstimates), `/diagnostics` (DiagnosticArray, 1 Hz) and `/rosout`
-//! (rcl_interfaces/Log). Serves the parameter services ([`services`]).
+//! `gnss/velocity` (TwistWithCovarianceStamped), `/clock` (rosgraph_msgs/Clock, for
+//! `use_sim_time`); publishes `odometry` (nav_msgs/Odometry, `map_frame` → `base_frame`),
+//! `fix` (NavSatFix), `~/noise_estimates` (NoiseEstimates), `/diagnostics`
+//! (DiagnosticArray, 1 Hz), `/rosout` (rcl_interfaces/Log) and, with `publish_tf`, `/tf`
+//! (tf2_msgs/TFMessage). Serves the parameter services ([`services`]).
 
 pub mod clock;
+pub mod fix_pairing;
 pub mod handler;
 pub mod input_stats;
 pub mod log_limit;
@@ -30,7 +32,7 @@ use ros2_client::{
 use crate::ros::args::NodeArgs;
 use crate::ros::msg::{
     Clock, DiagnosticArray, GnssMeasurements, Imu, Log, NavSatFix, NoiseEstimates, Odometry,
-    RosMessage, Time,
+    RosMessage, TFMessage, Time, TwistWithCovarianceStamped,
 };
 use crate::ros::names::resolve_remapped;
 
@@ -155,6 +157,7 @@ enum Event {
     Imu(Result<Imu, String>),
     Gnss(Result<GnssMeasurements, String>),
     Fix(Result<NavSatFix, String>),
+    Velocity(Result<TwistWithCovarianceStamped, String>),
     Clock(Result<Clock, String>),
     Param(ParamRequest),
     LogLine(LogLine),
@@ -209,6 +212,8 @@ struct Outputs {
     odometry: Output<Odometry>,
     fix: Output<NavSatFix>,
     noise: Output<NoiseEstimates>,
+    /// Only with `publish_tf`.
+    tf: Option<Output<TFMessage>>,
     recorder: Option<Recorder>,
     log: LogLimiter,
 }
@@ -221,6 +226,10 @@ impl Outputs {
                 OutMsg::Odometry(o) => self.odometry.send(*o, recorder, now),
                 OutMsg::Fix(f) => self.fix.send(f, recorder, now),
                 OutMsg::Noise(n) => self.noise.send(n, recorder, now),
+                OutMsg::Tf(t) => match &self.tf {
+                    Some(tf) => tf.send(t, recorder, now),
+                    None => Ok(()),
+                },
             };
             if let Err(e) = result {
                 self.log.warn("publish", &format!("publish failed: {e}"));
@@ -255,6 +264,8 @@ pub fn run(
     let imu_sub = subscription::<Imu>(&mut node, &names, "imu")?;
     let gnss_sub = subscription::<GnssMeasurements>(&mut node, &names, "gnss/measurements")?;
     let fix_sub = subscription::<NavSatFix>(&mut node, &names, "gnss/fix")?;
+    let velocity_sub =
+        subscription::<TwistWithCovarianceStamped>(&mut node, &names, "gnss/velocity")?;
     let clock_sub = subscription::<Clock>(&mut node, &names, "/clock")?;
     let recorder = match &args.record {
         Some(path) => Some(Recorder::create(path).map_err(NodeError::Record)?),
@@ -264,6 +275,11 @@ pub fn run(
         odometry: Output::new(&mut node, &names, "odometry")?,
         fix: Output::new(&mut node, &names, "fix")?,
         noise: Output::new(&mut node, &names, "~/noise_estimates")?,
+        tf: if params.frames.publish_tf {
+            Some(Output::new(&mut node, &names, "/tf")?)
+        } else {
+            None
+        },
         recorder,
         log: LogLimiter::default(),
     };
@@ -273,8 +289,8 @@ pub fn run(
     let config = params.config;
     let fqn = node.fully_qualified_name();
     let logger = rosout::logger_name(&fqn);
-    let mut core = NodeCore::new(config);
-    let mut parameters = ParameterServer::new(params.use_sim_time);
+    let mut core = NodeCore::new(config, params.frames.clone());
+    let mut parameters = ParameterServer::new(params.use_sim_time, params.frames);
     let mut clock = NodeClock::default();
     let mut stats = InputStats::default();
 
@@ -290,6 +306,10 @@ pub fn run(
         fix_sub
             .async_stream()
             .map(|r| Event::Fix(decoded(r)))
+            .boxed_local(),
+        velocity_sub
+            .async_stream()
+            .map(|r| Event::Velocity(decoded(r)))
             .boxed_local(),
         clock_sub
             .async_stream()
@@ -348,6 +368,13 @@ pub fn run(
                     match m {
                         Ok(m) => core.on_fix(&m),
                         Err(e) => undecodable(&mut core, "gnss/fix", &e),
+                    }
+                }
+                Event::Velocity(m) => {
+                    stats.record(Stream::Velocity, now_s());
+                    match m {
+                        Ok(m) => core.on_velocity(&m),
+                        Err(e) => undecodable(&mut core, "gnss/velocity", &e),
                     }
                 }
                 Event::Clock(Ok(m)) => {

@@ -3,9 +3,10 @@
 //! `SetParametersAtomically` in, responses out.
 //!
 //! The parameters are the core configuration's (`section.key`, human units, the names of
-//! the parameter file) plus `use_sim_time`. A set request is validated like the parameter
-//! file; only [`RUNTIME_PARAMETERS`] (and `use_sim_time`) are accepted while the node runs,
-//! every other parameter is read-only and a set is refused with the reason.
+//! the parameter file) plus the node's own `use_sim_time`, `map_frame`, `base_frame` and
+//! `publish_tf`. A set request is validated like the parameter file; only
+//! [`RUNTIME_PARAMETERS`] (and `use_sim_time`) are accepted while the node runs, every
+//! other parameter is read-only and a set is refused with the reason.
 
 use std::collections::{BTreeSet, HashMap};
 
@@ -23,19 +24,40 @@ use crate::config::Config;
 use crate::engine::RUNTIME_PARAMETERS;
 
 use super::param_docs;
-use super::params::USE_SIM_TIME;
+use super::params::{OutputFrames, BASE_FRAME, MAP_FRAME, PUBLISH_TF, USE_SIM_TIME};
 use super::NodeCore;
 
 /// `ListParameters` depth meaning "no limit".
 const DEPTH_RECURSIVE: u64 = 0;
 const SEPARATOR: char = '.';
 
-/// The parameter services' state: the descriptions and the node-level `use_sim_time`.
+/// The parameter services' state: the descriptions and the node-level parameters.
 #[derive(Debug, Clone)]
 pub struct ParameterServer {
     descriptions: HashMap<String, String>,
     use_sim_time: bool,
+    frames: OutputFrames,
 }
+
+/// Descriptions of the node's own parameters (the core's come from the manual).
+const NODE_DESCRIPTIONS: [(&str, &str); 4] = [
+    (
+        USE_SIM_TIME,
+        "The node's time (diagnostics and rosout stamps, input ages) follows /clock.",
+    ),
+    (
+        MAP_FRAME,
+        "Parent frame of odometry and /tf: ENU at the datum (REP-105 map). Read-only.",
+    ),
+    (
+        BASE_FRAME,
+        "Child frame of odometry and /tf, frame of fix: the vehicle body (FLU). Read-only.",
+    ),
+    (
+        PUBLISH_TF,
+        "Publish map_frame -> base_frame on /tf with each odometry. Read-only.",
+    ),
+];
 
 fn value(ptype: u8) -> ParameterValue {
     ParameterValue {
@@ -175,11 +197,16 @@ fn listed(name: &str, prefixes: &[String], depth: u64) -> bool {
 }
 
 impl ParameterServer {
-    /// Services starting with `use_sim_time` as given on the command line.
-    pub fn new(use_sim_time: bool) -> Self {
+    /// Services starting with the node parameters as given on the command line.
+    pub fn new(use_sim_time: bool, frames: OutputFrames) -> Self {
+        let mut descriptions = param_docs::descriptions();
+        for (name, text) in NODE_DESCRIPTIONS {
+            descriptions.insert(name.to_owned(), text.to_owned());
+        }
         Self {
-            descriptions: param_docs::descriptions(),
+            descriptions,
             use_sim_time,
+            frames,
         }
     }
 
@@ -188,14 +215,18 @@ impl ParameterServer {
         self.use_sim_time
     }
 
-    /// Every parameter with its value: `use_sim_time`, then the configuration's in file
+    /// Every parameter with its value: the node's, then the configuration's in file
     /// order.
     fn all(&self, config: &Config) -> Vec<(String, ParameterValue)> {
-        let sim_time = (
-            USE_SIM_TIME.to_owned(),
-            parameter_value(&Value::Bool(self.use_sim_time)),
-        );
-        std::iter::once(sim_time)
+        let f = &self.frames;
+        let node = [
+            (USE_SIM_TIME, Value::Bool(self.use_sim_time)),
+            (MAP_FRAME, Value::String(f.map_frame.clone())),
+            (BASE_FRAME, Value::String(f.base_frame.clone())),
+            (PUBLISH_TF, Value::Bool(f.publish_tf)),
+        ];
+        node.into_iter()
+            .map(|(name, v)| (name.to_owned(), parameter_value(&v)))
             .chain(
                 config
                     .parameters()
@@ -292,6 +323,12 @@ impl ParameterServer {
         let current = self
             .lookup(config, name)
             .ok_or_else(|| format!("no parameter `{name}`"))?;
+        if [MAP_FRAME, BASE_FRAME, PUBLISH_TF].contains(&name.as_str()) {
+            return Err(format!(
+                "`{name}` is read-only while the node runs (the TF tree's listeners expect \
+                 fixed frames): restart the node with -p {name}:=VALUE or a parameter file"
+            ));
+        }
         if !RUNTIME_PARAMETERS.contains(&name.as_str()) {
             return Err(format!(
                 "`{name}` is read-only while the node runs (the filter is built from it at \
@@ -408,7 +445,7 @@ mod tests {
 
     #[test]
     fn list_follows_prefixes_and_depth() {
-        let s = ParameterServer::new(false);
+        let s = ParameterServer::new(false, OutputFrames::default());
         let c = Config::default();
         let list = |prefixes: &[&str], depth| {
             let req = ListParametersRequest {
@@ -418,10 +455,14 @@ mod tests {
             s.list(&c, &req).result
         };
         let all = list(&[], DEPTH_RECURSIVE);
-        assert_eq!(all.names.len(), c.parameters().len() + 1);
+        assert_eq!(all.names.len(), c.parameters().len() + 4);
         assert!(all.names.contains(&"use_sim_time".to_owned()));
         assert!(all.prefixes.contains(&"gnss".to_owned()));
-        assert_eq!(list(&[], 1).names, vec!["use_sim_time"], "no separator");
+        assert_eq!(
+            list(&[], 1).names,
+            vec!["use_sim_time", "map_frame", "base_frame", "publish_tf"],
+            "no separator"
+        );
         let gnss = list(&["gnss"], DEPTH_RECURSIVE);
         assert!(gnss.names.iter().all(|n| n.starts_with("gnss.")));
         assert!(gnss.names.contains(&"gnss.elevation_mask_deg".to_owned()));
@@ -431,7 +472,7 @@ mod tests {
 
     #[test]
     fn get_types_and_describe() {
-        let s = ParameterServer::new(true);
+        let s = ParameterServer::new(true, OutputFrames::default());
         let c = Config::default();
         let n = names(&[
             "gnss.elevation_mask_deg",
@@ -470,8 +511,8 @@ mod tests {
 
     #[test]
     fn set_applies_runtime_parameters_and_refuses_the_rest_with_a_reason() {
-        let mut s = ParameterServer::new(false);
-        let mut core = NodeCore::new(Config::default());
+        let mut s = ParameterServer::new(false, OutputFrames::default());
+        let mut core = NodeCore::new(Config::default(), OutputFrames::default());
         let r = s.set(
             &mut core,
             &[
@@ -526,8 +567,8 @@ mod tests {
 
     #[test]
     fn set_atomically_is_all_or_nothing() {
-        let mut s = ParameterServer::new(false);
-        let mut core = NodeCore::new(Config::default());
+        let mut s = ParameterServer::new(false, OutputFrames::default());
+        let mut core = NodeCore::new(Config::default(), OutputFrames::default());
         let r = s.set_atomically(
             &mut core,
             &[
@@ -547,5 +588,42 @@ mod tests {
         );
         assert!(r.result.successful, "{}", r.result.reason);
         assert_eq!(core.engine().config().gnss.cn0_mask_dbhz, 20.0);
+    }
+
+    #[test]
+    fn frames_are_served_read_only() {
+        let frames = OutputFrames {
+            map_frame: "world_enu".to_owned(),
+            base_frame: "imu_link".to_owned(),
+            publish_tf: true,
+        };
+        let mut s = ParameterServer::new(false, frames);
+        let mut core = NodeCore::new(Config::default(), OutputFrames::default());
+        let c = Config::default();
+        let n = names(&["map_frame", "base_frame", "publish_tf"]);
+        let v = s.get(&c, &n).values;
+        assert_eq!(v[0].string_value, "world_enu");
+        assert_eq!(v[1].string_value, "imu_link");
+        assert!(v[2].boolean_value && v[2].ptype == ParameterType::BOOL);
+        let d = s.describe(&c, &n).values;
+        assert!(d.iter().all(|d| d.read_only), "{d:?}");
+        assert!(d[2].description.contains("/tf"), "{}", d[2].description);
+        let r = s.set(
+            &mut core,
+            &[param(
+                "base_frame",
+                ParameterValue {
+                    string_value: "other".into(),
+                    ..value(ParameterType::STRING)
+                },
+            )],
+        );
+        assert!(!r.results[0].successful);
+        assert!(
+            r.results[0].reason.contains("read-only"),
+            "{}",
+            r.results[0].reason
+        );
+        assert_eq!(s.get(&c, &n).values[1].string_value, "imu_link");
     }
 }

@@ -20,8 +20,12 @@ pub enum ParamsError {
     },
     #[error(transparent)]
     Config(Box<ConfigError>),
-    #[error("use_sim_time must be true or false, not `{0}`")]
-    SimTime(String),
+    #[error("{name}: {reason}, not `{value}`")]
+    NodeParameter {
+        name: &'static str,
+        value: String,
+        reason: &'static str,
+    },
     #[error("-p {name}:={value}: {source}")]
     Override {
         name: String,
@@ -38,37 +42,137 @@ pub enum ParamsError {
 /// carry those stamps.
 pub const USE_SIM_TIME: &str = "use_sim_time";
 
+/// Frame of the odometry pose and the TF parent (REP-105 `map`: ENU at the datum).
+pub const MAP_FRAME: &str = "map_frame";
+/// Frame of the vehicle body (FLU), the odometry's child frame and NavSatFix's frame.
+pub const BASE_FRAME: &str = "base_frame";
+/// Whether `map_frame` → `base_frame` is published on `/tf` with each Odometry.
+pub const PUBLISH_TF: &str = "publish_tf";
+/// The node's own parameters, outside the core configuration.
+pub const NODE_PARAMETERS: [&str; 4] = [USE_SIM_TIME, MAP_FRAME, BASE_FRAME, PUBLISH_TF];
+
+/// The frames of the node's outputs and whether it publishes them on `/tf`.
+///
+/// Choice: fixed at start (read-only through the parameter services): a TF tree whose
+/// frames change while it runs would break its listeners.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct OutputFrames {
+    /// Parent frame of Odometry and TF (default `map`).
+    pub map_frame: String,
+    /// Child frame of Odometry and TF, frame of NavSatFix (default `base_link`).
+    pub base_frame: String,
+    /// Publish the TF `map_frame` → `base_frame` (default false).
+    pub publish_tf: bool,
+}
+
+impl Default for OutputFrames {
+    fn default() -> Self {
+        Self {
+            map_frame: "map".to_owned(),
+            base_frame: "base_link".to_owned(),
+            publish_tf: false,
+        }
+    }
+}
+
 /// What the command line configures: the core's configuration and the node's own
-/// `use_sim_time`.
+/// parameters.
 #[derive(Debug, Clone)]
 pub struct NodeParams {
     /// The engine's configuration.
     pub config: Config,
     /// Whether the node's time follows `/clock`.
     pub use_sim_time: bool,
+    /// Output frames and TF.
+    pub frames: OutputFrames,
 }
 
-/// The `use_sim_time` of the params file and the `-p` overrides (the last one wins;
-/// default false).
-fn use_sim_time_from(args: &NodeArgs, params_text: Option<&str>) -> Result<bool, ParamsError> {
-    let mut value = false;
+/// The value of the node parameter `name` from the params file and the `-p` overrides (the
+/// last one wins), as YAML; None when neither sets it.
+fn node_value(
+    args: &NodeArgs,
+    params_text: Option<&str>,
+    name: &'static str,
+) -> Result<Option<serde_yaml::Value>, ParamsError> {
+    let mut value = None;
     let document = params_text.and_then(|t| serde_yaml::from_str::<serde_yaml::Value>(t).ok());
     if let Some(serde_yaml::Value::Mapping(nodes)) = document {
         for (_, node) in nodes {
-            if let Some(v) = node
-                .get("ros__parameters")
-                .and_then(|p| p.get(USE_SIM_TIME))
-            {
-                value = v
-                    .as_bool()
-                    .ok_or_else(|| ParamsError::SimTime(format!("{v:?}")))?;
+            if let Some(v) = node.get("ros__parameters").and_then(|p| p.get(name)) {
+                value = Some(v.clone());
             }
         }
     }
-    for (_, v) in args.parameters.iter().filter(|(n, _)| n == USE_SIM_TIME) {
-        value = serde_yaml::from_str::<bool>(v).map_err(|_| ParamsError::SimTime(v.clone()))?;
+    for (_, v) in args.parameters.iter().filter(|(n, _)| n == name) {
+        let parsed = serde_yaml::from_str::<serde_yaml::Value>(v).map_err(|_| {
+            ParamsError::NodeParameter {
+                name,
+                value: v.clone(),
+                reason: "not a YAML value",
+            }
+        })?;
+        value = Some(parsed);
     }
     Ok(value)
+}
+
+fn node_bool(
+    args: &NodeArgs,
+    params_text: Option<&str>,
+    name: &'static str,
+    default: bool,
+) -> Result<bool, ParamsError> {
+    match node_value(args, params_text, name)? {
+        None => Ok(default),
+        Some(v) => v.as_bool().ok_or_else(|| ParamsError::NodeParameter {
+            name,
+            value: shown(&v),
+            reason: "must be true or false",
+        }),
+    }
+}
+
+/// A frame id: a non-empty string without spaces.
+fn node_frame(
+    args: &NodeArgs,
+    params_text: Option<&str>,
+    name: &'static str,
+    default: &str,
+) -> Result<String, ParamsError> {
+    match node_value(args, params_text, name)? {
+        None => Ok(default.to_owned()),
+        Some(serde_yaml::Value::String(s)) if !s.is_empty() && !s.contains(char::is_whitespace) => {
+            Ok(s)
+        }
+        Some(v) => Err(ParamsError::NodeParameter {
+            name,
+            value: shown(&v),
+            reason: "must be a frame id (a non-empty string without spaces)",
+        }),
+    }
+}
+
+fn shown(v: &serde_yaml::Value) -> String {
+    serde_yaml::to_string(v)
+        .map(|t| t.trim_end().to_owned())
+        .unwrap_or_default()
+}
+
+fn frames_from(args: &NodeArgs, params_text: Option<&str>) -> Result<OutputFrames, ParamsError> {
+    let defaults = OutputFrames::default();
+    let frames = OutputFrames {
+        map_frame: node_frame(args, params_text, MAP_FRAME, &defaults.map_frame)?,
+        base_frame: node_frame(args, params_text, BASE_FRAME, &defaults.base_frame)?,
+        publish_tf: node_bool(args, params_text, PUBLISH_TF, defaults.publish_tf)?,
+    };
+    if frames.map_frame == frames.base_frame {
+        return Err(ParamsError::NodeParameter {
+            name: BASE_FRAME,
+            value: frames.base_frame,
+            reason: "must differ from map_frame",
+        });
+    }
+    Ok(frames)
 }
 
 /// The node's parameters of `args` where `params_text` is the content of
@@ -79,7 +183,8 @@ pub fn node_params_from(
 ) -> Result<NodeParams, ParamsError> {
     Ok(NodeParams {
         config: config_from(args, params_text)?,
-        use_sim_time: use_sim_time_from(args, params_text)?,
+        use_sim_time: node_bool(args, params_text, USE_SIM_TIME, false)?,
+        frames: frames_from(args, params_text)?,
     })
 }
 
@@ -93,12 +198,13 @@ pub fn config_from(args: &NodeArgs, params_text: Option<&str>) -> Result<Config,
     let mut config = match params_text {
         Some(text) => {
             check_node_key(text, &origin, args)?;
-            let text = without_use_sim_time(text);
+            let text = without_node_parameters(text);
             Config::from_yaml_str(&text, &origin).map_err(|e| ParamsError::Config(Box::new(e)))?
         }
         None => Config::default(),
     };
-    for (name, value) in args.parameters.iter().filter(|(n, _)| n != USE_SIM_TIME) {
+    let core = |n: &String| !NODE_PARAMETERS.contains(&n.as_str());
+    for (name, value) in args.parameters.iter().filter(|(n, _)| core(n)) {
         config
             .set_parameter(name, value)
             .map_err(|source| ParamsError::Override {
@@ -110,9 +216,9 @@ pub fn config_from(args: &NodeArgs, params_text: Option<&str>) -> Result<Config,
     Ok(config)
 }
 
-/// `text` without a `use_sim_time` entry under its node's `ros__parameters` (unchanged,
+/// `text` without the [`NODE_PARAMETERS`] under its node's `ros__parameters` (unchanged,
 /// keeping the line numbers of the loader's errors, when there is none).
-fn without_use_sim_time(text: &str) -> std::borrow::Cow<'_, str> {
+fn without_node_parameters(text: &str) -> std::borrow::Cow<'_, str> {
     use serde_yaml::Value;
     let Ok(mut document) = serde_yaml::from_str::<Value>(text) else {
         return text.into();
@@ -121,7 +227,9 @@ fn without_use_sim_time(text: &str) -> std::borrow::Cow<'_, str> {
     if let Value::Mapping(nodes) = &mut document {
         for (_, node) in nodes.iter_mut() {
             if let Some(Value::Mapping(parameters)) = node.get_mut("ros__parameters") {
-                removed |= parameters.remove(USE_SIM_TIME).is_some();
+                for name in NODE_PARAMETERS {
+                    removed |= parameters.remove(name).is_some();
+                }
             }
         }
     }
@@ -237,7 +345,7 @@ mod tests {
                 .use_sim_time
         );
         let e = node_params_from(&args(&["-p", "use_sim_time:=maybe"]), Some(FILE));
-        assert!(matches!(e, Err(ParamsError::SimTime(_))));
+        assert!(matches!(e, Err(ParamsError::NodeParameter { .. })));
         // Files without it keep the loader's line numbers in errors.
         let bad = FILE.replace("ermakf", "no_such_variant");
         let e = config_from(&args(&[]), Some(&bad)).unwrap_err().to_string();
@@ -252,6 +360,38 @@ mod tests {
             let text = std::fs::read_to_string(&path).unwrap();
             let a = parse(["--ros-args", "--params-file", path.to_str().unwrap()]).unwrap();
             config_from(&a, Some(&text)).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        }
+    }
+
+    #[test]
+    fn frames_and_publish_tf_are_the_nodes() {
+        let p = node_params_from(&args(&[]), Some(FILE)).unwrap();
+        assert_eq!(p.frames, OutputFrames::default());
+        assert_eq!(p.frames.map_frame, "map");
+        assert_eq!(p.frames.base_frame, "base_link");
+        assert!(!p.frames.publish_tf);
+        let file = FILE.replace(
+            "ros__parameters:\n",
+            "ros__parameters:\n    map_frame: odom_enu\n    publish_tf: true\n",
+        );
+        let p = node_params_from(&args(&["-p", "base_frame:=imu_link"]), Some(&file)).unwrap();
+        assert_eq!(p.config.filter.variant.as_str(), "ermakf");
+        assert_eq!(p.frames.map_frame, "odom_enu");
+        assert_eq!(p.frames.base_frame, "imu_link");
+        assert!(p.frames.publish_tf);
+        let p = node_params_from(&args(&["-p", "publish_tf:=false"]), Some(&file)).unwrap();
+        assert!(!p.frames.publish_tf, "-p wins over the file");
+        for bad in [
+            "publish_tf:=yes please",
+            "base_frame:=''",
+            "map_frame:=12",
+            "base_frame:=map",
+        ] {
+            let e = node_params_from(&args(&["-p", bad]), Some(FILE));
+            assert!(
+                matches!(e, Err(ParamsError::NodeParameter { .. })),
+                "{bad}: {e:?}"
+            );
         }
     }
 }
