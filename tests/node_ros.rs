@@ -54,6 +54,7 @@ fn node_estimates_a_static_receiver() {
         .args(["-p", "init.heading_deg:=0.0", "-p", &datum])
         .args(["-r", "__ns:=/test", "-r", "imu:=imu/data"])
         .args(["-p", "publish_tf:=true", "-p", "base_frame:=imu_link"])
+        .args(["-p", "queue_depth:=500"])
         .env("ROS_DOMAIN_ID", DOMAIN_ID.to_string())
         .env("RUST_LOG", "info,rustdds=error,ros2_client=warn")
         .stdin(Stdio::null())

@@ -47,12 +47,6 @@ use rosout::{LogLine, LogLines};
 pub use services::service_mapping_from;
 use services::{ParamRequest, ParameterServices};
 
-/// Queue depth of the subscriptions and publishers.
-///
-/// Choice: 200 holds one second of a 200 Hz IMU, so a short stall of the node loses
-/// nothing; GNSS (1–10 Hz) needs far less but a common depth keeps things simple.
-pub const QUEUE_DEPTH: usize = 200;
-
 /// Period of the /diagnostics report.
 pub const DIAGNOSTICS_PERIOD: Duration = Duration::from_secs(1);
 
@@ -93,15 +87,15 @@ fn type_name<M: RosMessage>() -> MessageTypeName {
 }
 
 /// Best-effort subscription QoS: matches both best-effort and reliable publishers.
-fn sensor_qos() -> QosProfile {
+fn sensor_qos(depth: usize) -> QosProfile {
     QosProfile::subscription_default()
         .reliability_best_effort()
-        .history(History::KeepLast { depth: QUEUE_DEPTH })
+        .history(History::KeepLast { depth })
 }
 
 /// Reliable publisher QoS (matches reliable and best-effort subscribers).
-fn output_qos() -> QosProfile {
-    QosProfile::publisher_default().history(History::KeepLast { depth: QUEUE_DEPTH })
+fn output_qos(depth: usize) -> QosProfile {
+    QosProfile::publisher_default().history(History::KeepLast { depth })
 }
 
 /// `/rosout` QoS as rcl offers it: reliable, transient local, the last 1000 lines (so a
@@ -112,8 +106,10 @@ fn rosout_qos() -> QosProfile {
         .history(History::KeepLast { depth: 1000 })
 }
 
+/// Topic naming and the history depth of the node's DDS entities.
 struct Names<'a> {
     args: &'a NodeArgs,
+    queue_depth: usize,
 }
 
 impl Names<'_> {
@@ -131,10 +127,10 @@ fn subscription<M: RosMessage + 'static>(
 ) -> Result<Subscription<M>, NodeError> {
     let name = names.topic(relative)?;
     let topic = node
-        .create_topic(&name, type_name::<M>(), &sensor_qos())
+        .create_topic(&name, type_name::<M>(), &sensor_qos(names.queue_depth))
         .map_err(dds_error)?;
     log::info!("subscribing {name} ({})", M::TYPE_NAME);
-    node.create_subscription::<M>(&topic, Some(sensor_qos()))
+    node.create_subscription::<M>(&topic, Some(sensor_qos(names.queue_depth)))
         .map_err(dds_error)
 }
 
@@ -182,7 +178,7 @@ struct Output<M: RosMessage> {
 
 impl<M: RosMessage + std::fmt::Debug> Output<M> {
     fn new(node: &mut Node, names: &Names, relative: &str) -> Result<Self, NodeError> {
-        Self::with_qos(node, names, relative, output_qos())
+        Self::with_qos(node, names, relative, output_qos(names.queue_depth))
     }
 
     fn with_qos(
@@ -260,7 +256,10 @@ pub fn run(
                 .start_parameter_services(false),
         )
         .map_err(dds_error)?;
-    let names = Names { args };
+    let names = Names {
+        args,
+        queue_depth: params.queue_depth,
+    };
     let imu_sub = subscription::<Imu>(&mut node, &names, "imu")?;
     let gnss_sub = subscription::<GnssMeasurements>(&mut node, &names, "gnss/measurements")?;
     let fix_sub = subscription::<NavSatFix>(&mut node, &names, "gnss/fix")?;
@@ -290,7 +289,8 @@ pub fn run(
     let fqn = node.fully_qualified_name();
     let logger = rosout::logger_name(&fqn);
     let mut core = NodeCore::new(config, params.frames.clone());
-    let mut parameters = ParameterServer::new(params.use_sim_time, params.frames);
+    let mut parameters = ParameterServer::new(params.use_sim_time, params.frames)
+        .with_queue_depth(params.queue_depth);
     let mut clock = NodeClock::default();
     let mut stats = InputStats::default();
 

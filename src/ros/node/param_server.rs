@@ -24,7 +24,9 @@ use crate::config::Config;
 use crate::engine::RUNTIME_PARAMETERS;
 
 use super::param_docs;
-use super::params::{OutputFrames, BASE_FRAME, MAP_FRAME, PUBLISH_TF, USE_SIM_TIME};
+use super::params::{
+    OutputFrames, BASE_FRAME, DEFAULT_QUEUE_DEPTH, MAP_FRAME, PUBLISH_TF, QUEUE_DEPTH, USE_SIM_TIME,
+};
 use super::NodeCore;
 
 /// `ListParameters` depth meaning "no limit".
@@ -37,10 +39,11 @@ pub struct ParameterServer {
     descriptions: HashMap<String, String>,
     use_sim_time: bool,
     frames: OutputFrames,
+    queue_depth: usize,
 }
 
 /// Descriptions of the node's own parameters (the core's come from the manual).
-const NODE_DESCRIPTIONS: [(&str, &str); 4] = [
+const NODE_DESCRIPTIONS: [(&str, &str); 5] = [
     (
         USE_SIM_TIME,
         "The node's time (diagnostics and rosout stamps, input ages) follows /clock.",
@@ -56,6 +59,10 @@ const NODE_DESCRIPTIONS: [(&str, &str); 4] = [
     (
         PUBLISH_TF,
         "Publish map_frame -> base_frame on /tf with each odometry. Read-only.",
+    ),
+    (
+        QUEUE_DEPTH,
+        "History depth (messages) of the input subscriptions and the publishers. Read-only.",
     ),
 ];
 
@@ -207,7 +214,14 @@ impl ParameterServer {
             descriptions,
             use_sim_time,
             frames,
+            queue_depth: DEFAULT_QUEUE_DEPTH,
         }
+    }
+
+    /// The server reporting `depth` as the node's `queue_depth`.
+    pub fn with_queue_depth(mut self, depth: usize) -> Self {
+        self.queue_depth = depth;
+        self
     }
 
     /// The current `use_sim_time`.
@@ -224,6 +238,7 @@ impl ParameterServer {
             (MAP_FRAME, Value::String(f.map_frame.clone())),
             (BASE_FRAME, Value::String(f.base_frame.clone())),
             (PUBLISH_TF, Value::Bool(f.publish_tf)),
+            (QUEUE_DEPTH, Value::Number(self.queue_depth.into())),
         ];
         node.into_iter()
             .map(|(name, v)| (name.to_owned(), parameter_value(&v)))
@@ -323,6 +338,12 @@ impl ParameterServer {
         let current = self
             .lookup(config, name)
             .ok_or_else(|| format!("no parameter `{name}`"))?;
+        if name == QUEUE_DEPTH {
+            return Err(format!(
+                "`{name}` is read-only while the node runs (the DDS entities are created \
+                 with it): restart the node with -p {name}:=VALUE or a parameter file"
+            ));
+        }
         if [MAP_FRAME, BASE_FRAME, PUBLISH_TF].contains(&name.as_str()) {
             return Err(format!(
                 "`{name}` is read-only while the node runs (the TF tree's listeners expect \
@@ -455,12 +476,21 @@ mod tests {
             s.list(&c, &req).result
         };
         let all = list(&[], DEPTH_RECURSIVE);
-        assert_eq!(all.names.len(), c.parameters().len() + 4);
+        assert_eq!(
+            all.names.len(),
+            c.parameters().len() + NODE_DESCRIPTIONS.len()
+        );
         assert!(all.names.contains(&"use_sim_time".to_owned()));
         assert!(all.prefixes.contains(&"gnss".to_owned()));
         assert_eq!(
             list(&[], 1).names,
-            vec!["use_sim_time", "map_frame", "base_frame", "publish_tf"],
+            vec![
+                "use_sim_time",
+                "map_frame",
+                "base_frame",
+                "publish_tf",
+                "queue_depth"
+            ],
             "no separator"
         );
         let gnss = list(&["gnss"], DEPTH_RECURSIVE);

@@ -48,8 +48,19 @@ pub const MAP_FRAME: &str = "map_frame";
 pub const BASE_FRAME: &str = "base_frame";
 /// Whether `map_frame` → `base_frame` is published on `/tf` with each Odometry.
 pub const PUBLISH_TF: &str = "publish_tf";
+/// Depth (messages) of the input subscriptions' and the publishers' history.
+pub const QUEUE_DEPTH: &str = "queue_depth";
 /// The node's own parameters, outside the core configuration.
-pub const NODE_PARAMETERS: [&str; 4] = [USE_SIM_TIME, MAP_FRAME, BASE_FRAME, PUBLISH_TF];
+pub const NODE_PARAMETERS: [&str; 5] =
+    [USE_SIM_TIME, MAP_FRAME, BASE_FRAME, PUBLISH_TF, QUEUE_DEPTH];
+
+/// Default of [`QUEUE_DEPTH`].
+///
+/// Choice: 200 holds one second of a 200 Hz IMU, so a short stall of the node loses
+/// nothing; GNSS (1–10 Hz) needs far less but a common depth keeps things simple.
+pub const DEFAULT_QUEUE_DEPTH: usize = 200;
+/// Largest accepted [`QUEUE_DEPTH`] (a minute of a 1 kHz IMU).
+pub const MAX_QUEUE_DEPTH: usize = 60_000;
 
 /// The frames of the node's outputs and whether it publishes them on `/tf`.
 ///
@@ -85,6 +96,8 @@ pub struct NodeParams {
     pub use_sim_time: bool,
     /// Output frames and TF.
     pub frames: OutputFrames,
+    /// History depth of the subscriptions and publishers.
+    pub queue_depth: usize,
 }
 
 /// The value of the node parameter `name` from the params file and the `-p` overrides (the
@@ -152,6 +165,22 @@ fn node_frame(
     }
 }
 
+/// A history depth: an integer in 1..=[`MAX_QUEUE_DEPTH`].
+fn node_depth(args: &NodeArgs, params_text: Option<&str>) -> Result<usize, ParamsError> {
+    match node_value(args, params_text, QUEUE_DEPTH)? {
+        None => Ok(DEFAULT_QUEUE_DEPTH),
+        Some(v) => v
+            .as_u64()
+            .and_then(|d| usize::try_from(d).ok())
+            .filter(|d| (1..=MAX_QUEUE_DEPTH).contains(d))
+            .ok_or_else(|| ParamsError::NodeParameter {
+                name: QUEUE_DEPTH,
+                value: shown(&v),
+                reason: "must be an integer from 1 to 60000",
+            }),
+    }
+}
+
 fn shown(v: &serde_yaml::Value) -> String {
     serde_yaml::to_string(v)
         .map(|t| t.trim_end().to_owned())
@@ -185,6 +214,7 @@ pub fn node_params_from(
         config: config_from(args, params_text)?,
         use_sim_time: node_bool(args, params_text, USE_SIM_TIME, false)?,
         frames: frames_from(args, params_text)?,
+        queue_depth: node_depth(args, params_text)?,
     })
 }
 
@@ -360,6 +390,21 @@ mod tests {
             let text = std::fs::read_to_string(&path).unwrap();
             let a = parse(["--ros-args", "--params-file", path.to_str().unwrap()]).unwrap();
             config_from(&a, Some(&text)).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        }
+    }
+
+    #[test]
+    fn queue_depth_is_the_nodes_and_checked() {
+        let p = node_params_from(&args(&[]), None).unwrap();
+        assert_eq!(p.queue_depth, DEFAULT_QUEUE_DEPTH);
+        let p = node_params_from(&args(&["-p", "queue_depth:=1000"]), None).unwrap();
+        assert_eq!(p.queue_depth, 1000);
+        for bad in ["0", "-3", "2.5", "deep", "60001"] {
+            let set = format!("queue_depth:={bad}");
+            assert!(
+                node_params_from(&args(&["-p", &set]), None).is_err(),
+                "{bad} accepted"
+            );
         }
     }
 
