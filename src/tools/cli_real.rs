@@ -81,6 +81,25 @@ pub enum EphemerisArg {
     AsReceived,
 }
 
+/// The reference trajectory and time scale of a conversion (`convert`, and `spp` of a
+/// UBX log).
+#[derive(Args, Clone)]
+pub struct ReferenceArgs {
+    /// Reference from the log's UBX-NAV-PVT solutions (e.g. a receiver running RTK).
+    #[arg(long, conflicts_with = "truth_pos")]
+    pub truth_ubx: bool,
+    /// Reference from an RTKLIB .pos file (GPST).
+    #[arg(long)]
+    pub truth_pos: Option<PathBuf>,
+    /// Geoid separation (m) added to the .pos heights (0 when they are ellipsoidal; the
+    /// receiver's NAV-PVT height − hMSL when they are above mean sea level).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub geoid_separation_m: f64,
+    /// GPS − UTC leap seconds: ROS stamps are GPST − this.
+    #[arg(long, default_value_t = DEFAULT_GPS_UTC_LEAP_S)]
+    pub leap_seconds: f64,
+}
+
 /// Arguments of `gnss_ins convert`.
 #[derive(Args)]
 pub struct ConvertArgs {
@@ -120,19 +139,8 @@ pub struct ConvertArgs {
     /// the tag's last record.
     #[arg(long)]
     pub imu_tag: Option<PathBuf>,
-    /// Reference from the log's UBX-NAV-PVT solutions (e.g. a receiver running RTK).
-    #[arg(long, conflicts_with = "truth_pos")]
-    pub truth_ubx: bool,
-    /// Reference from an RTKLIB .pos file (GPST).
-    #[arg(long)]
-    pub truth_pos: Option<PathBuf>,
-    /// Geoid separation (m) added to the .pos heights (0 when they are ellipsoidal; the
-    /// receiver's NAV-PVT height − hMSL when they are above mean sea level).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
-    pub geoid_separation_m: f64,
-    /// GPS − UTC leap seconds: ROS stamps are GPST − this.
-    #[arg(long, default_value_t = DEFAULT_GPS_UTC_LEAP_S)]
-    pub leap_seconds: f64,
+    #[command(flatten)]
+    pub reference: ReferenceArgs,
     #[arg(long, value_enum, default_value_t = EphemerisArg::WholeLog)]
     pub ephemeris: EphemerisArg,
     #[arg(long, value_enum, default_value_t = IonosphereArg::IonoFree)]
@@ -181,10 +189,11 @@ impl ConvertArgs {
                 })
             }
         };
-        let truth = match (&self.truth_pos, self.truth_ubx) {
+        let r = &self.reference;
+        let truth = match (&r.truth_pos, r.truth_ubx) {
             (Some(path), _) => TruthInput::Pos {
                 path: path.clone(),
-                geoid_separation_m: self.geoid_separation_m,
+                geoid_separation_m: r.geoid_separation_m,
             },
             (None, true) => TruthInput::UbxNavPvt,
             (None, false) => TruthInput::None,
@@ -201,7 +210,7 @@ impl ConvertArgs {
             gnss,
             imu,
             truth,
-            leap_seconds: self.leap_seconds,
+            leap_seconds: r.leap_seconds,
             ephemeris: match self.ephemeris {
                 EphemerisArg::WholeLog => EphemerisMode::WholeLog,
                 EphemerisArg::AsReceived => EphemerisMode::AsReceived,
@@ -220,18 +229,9 @@ pub struct SppArgs {
     /// Parameter file whose gnss.* settings (mask, σ model, constellations) are used.
     #[arg(long)]
     pub params: Option<PathBuf>,
-    /// With a UBX log: reference from its UBX-NAV-PVT solutions.
-    #[arg(long, conflicts_with = "truth_pos")]
-    pub truth_ubx: bool,
-    /// With a UBX log: reference from an RTKLIB .pos file (GPST).
-    #[arg(long)]
-    pub truth_pos: Option<PathBuf>,
-    /// With --truth-pos: geoid separation (m) added to its heights.
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
-    pub geoid_separation_m: f64,
-    /// With a UBX log: GPS − UTC leap seconds.
-    #[arg(long, default_value_t = DEFAULT_GPS_UTC_LEAP_S)]
-    pub leap_seconds: f64,
+    /// With a UBX log: its reference and time scale (as for `convert`).
+    #[command(flatten)]
+    pub reference: ReferenceArgs,
     /// With a UBX log: the pseudo-ranges to form (as `convert --ionosphere`).
     #[arg(long, value_enum, default_value_t = IonosphereArg::IonoFree)]
     pub ionosphere: IonosphereArg,
@@ -302,10 +302,7 @@ pub fn spp(args: SppArgs) -> Result<(), String> {
             imu_gyro_unit: GyroUnitArg::DegPerS,
             imu_to_flu_rpy_deg: vec![0.0; 3],
             imu_tag: None,
-            truth_ubx: args.truth_ubx,
-            truth_pos: args.truth_pos.clone(),
-            geoid_separation_m: args.geoid_separation_m,
-            leap_seconds: args.leap_seconds,
+            reference: args.reference.clone(),
             ephemeris: EphemerisArg::WholeLog,
             ionosphere: args.ionosphere,
             out: temp.clone(),
