@@ -213,6 +213,55 @@ pub fn update(
     Ok(report)
 }
 
+/// Predicts satellites' measurements from one filter state: the antenna's position and
+/// velocity are computed once, then each satellite is predicted from them.
+struct StatePredictor<'a> {
+    rx_pos: Vector3<f64>,
+    rx_vel: Vector3<f64>,
+    state: &'a FilterState,
+    epoch: &'a GnssEpoch,
+}
+
+impl<'a> StatePredictor<'a> {
+    fn new(
+        state: &'a FilterState,
+        epoch: &'a GnssEpoch,
+        w_ib_b_rad_s: &Vector3<f64>,
+        config: &Config,
+    ) -> Self {
+        let geo = AntennaGeometry::new(&state.nav, &config.mounting.lever_arm_b_m, w_ib_b_rad_s);
+        Self {
+            rx_pos: geo.antenna_ecef_m(&state.nav.p),
+            rx_vel: geo.antenna_velocity_ecef_mps(&state.nav.v_n),
+            state,
+            epoch,
+        }
+    }
+
+    /// The prediction of the epoch's satellite `obs_index`; None when it fails.
+    fn predict(&self, obs_index: usize) -> Option<SatPrediction> {
+        let obs = self.epoch.satellites.get(obs_index)?;
+        geometry::predict(
+            obs,
+            &self.rx_pos,
+            &self.rx_vel,
+            self.state.clock_bias_m,
+            self.state.clock_drift_mps,
+            self.epoch.klobuchar.as_ref(),
+            self.epoch.gps_time_of_week_s,
+        )
+        .ok()
+    }
+}
+
+/// The predicted value of `observable`.
+fn predicted(p: &SatPrediction, observable: Observable) -> f64 {
+    match observable {
+        Observable::Pseudorange => p.pseudorange_m,
+        Observable::PseudorangeRate => p.pseudorange_rate_mps,
+    }
+}
+
 /// The predictions of the candidates (same order) from `state`; None when one fails.
 fn predict_candidates(
     state: &FilterState,
@@ -221,26 +270,10 @@ fn predict_candidates(
     w_ib_b_rad_s: &Vector3<f64>,
     config: &Config,
 ) -> Option<DVector<f64>> {
-    let geo = AntennaGeometry::new(&state.nav, &config.mounting.lever_arm_b_m, w_ib_b_rad_s);
-    let rx_pos = geo.antenna_ecef_m(&state.nav.p);
-    let rx_vel = geo.antenna_velocity_ecef_mps(&state.nav.v_n);
+    let predictor = StatePredictor::new(state, epoch, w_ib_b_rad_s, config);
     let mut out = DVector::zeros(candidates.len());
     for (i, c) in candidates.iter().enumerate() {
-        let obs = epoch.satellites.get(c.obs_index)?;
-        let p = geometry::predict(
-            obs,
-            &rx_pos,
-            &rx_vel,
-            state.clock_bias_m,
-            state.clock_drift_mps,
-            epoch.klobuchar.as_ref(),
-            epoch.gps_time_of_week_s,
-        )
-        .ok()?;
-        out[i] = match c.observable {
-            Observable::Pseudorange => p.pseudorange_m,
-            Observable::PseudorangeRate => p.pseudorange_rate_mps,
-        };
+        out[i] = predicted(&predictor.predict(c.obs_index)?, c.observable);
     }
     Some(out)
 }
@@ -254,9 +287,7 @@ fn posterior_predictions(
     config: &Config,
     screened: Vec<(usize, ScalarMeasurement)>,
 ) -> (Vec<ScalarMeasurement>, Vec<f64>) {
-    let geo = AntennaGeometry::new(&state.nav, &config.mounting.lever_arm_b_m, w_ib_b_rad_s);
-    let rx_pos = geo.antenna_ecef_m(&state.nav.p);
-    let rx_vel = geo.antenna_velocity_ecef_mps(&state.nav.v_n);
+    let predictor = StatePredictor::new(state, epoch, w_ib_b_rad_s, config);
     let mut posterior = Vec::with_capacity(screened.len());
     let mut rows = Vec::with_capacity(screened.len());
     // A satellite's pseudo-range and rate rows are adjacent: predict it once for both.
@@ -265,26 +296,12 @@ fn posterior_predictions(
         let value = match last {
             Some((index, value)) if index == obs_index => value,
             _ => {
-                let value = epoch.satellites.get(obs_index).and_then(|obs| {
-                    geometry::predict(
-                        obs,
-                        &rx_pos,
-                        &rx_vel,
-                        state.clock_bias_m,
-                        state.clock_drift_mps,
-                        epoch.klobuchar.as_ref(),
-                        epoch.gps_time_of_week_s,
-                    )
-                    .ok()
-                });
+                let value = predictor.predict(obs_index);
                 last = Some((obs_index, value));
                 value
             }
         };
-        posterior.push(value.map_or(f64::NAN, |p| match row.observable {
-            Observable::Pseudorange => p.pseudorange_m,
-            Observable::PseudorangeRate => p.pseudorange_rate_mps,
-        }));
+        posterior.push(value.map_or(f64::NAN, |p| predicted(&p, row.observable)));
         rows.push(row);
     }
     (rows, posterior)
