@@ -24,6 +24,12 @@ const IN_NETNS: &str = "GNSS_INS_PLAY_TEST_IN_NETNS";
 const DOMAIN_ID: u16 = 23;
 /// Playing speed: the 36 s fixture plays in 9 s.
 const RATE: f64 = 4.0;
+/// `--delay` of the player, seconds. `--wait-for` only knows that the player's writer has
+/// matched the subscriber; the subscriber's side of the match completes on its own, and
+/// a message that arrives before it is dropped there and repaired only while the
+/// player's history still holds it. A loaded CI machine once lost the first Imu message
+/// that way, so the player waits as a user of `ros2 bag play --delay` would.
+const PLAYER_DELAY_S: &str = "2";
 
 fn reexec_in_private_netns(name: &str) -> bool {
     if std::env::var_os(IN_NETNS).is_some() {
@@ -86,6 +92,18 @@ fn drain<M: RosMessage + 'static>(subscription: &Subscription<M>, into: &mut Vec
     }
 }
 
+/// Received payloads equal the recorded ones; a failure names the first difference.
+fn assert_same_messages(what: &str, got: &[Vec<u8>], want: &[Vec<u8>]) {
+    let first_difference = got.iter().zip(want).position(|(g, w)| g != w);
+    assert!(
+        got.len() == want.len() && first_difference.is_none(),
+        "{what}: received {} of {} messages, first difference at index {:?}",
+        got.len(),
+        want.len(),
+        first_difference.or((got.len() != want.len()).then_some(got.len().min(want.len())))
+    );
+}
+
 #[test]
 fn play_publishes_the_bag_unchanged() {
     if reexec_in_private_netns("play_publishes_the_bag_unchanged") {
@@ -109,6 +127,7 @@ fn play_publishes_the_bag_unchanged() {
         .arg(fixture())
         .args(["--rate", &RATE.to_string(), "--clock"])
         .args(["--wait-for", "/imu", "--wait-for", "/gnss/measurements"])
+        .args(["--delay", PLAYER_DELAY_S])
         .env("ROS_DOMAIN_ID", DOMAIN_ID.to_string())
         .env("RUST_LOG", "warn,rustdds=error")
         .stdout(Stdio::piped())
@@ -139,16 +158,8 @@ fn play_publishes_the_bag_unchanged() {
     }
     drain(&clock_sub, &mut clock);
 
-    assert_eq!(imu.len(), want_imu.len(), "Imu messages received");
-    assert!(
-        encoded(&imu) == want_imu,
-        "Imu messages differ from the bag's"
-    );
-    assert_eq!(gnss.len(), want_gnss.len(), "GnssMeasurements received");
-    assert!(
-        encoded(&gnss) == want_gnss,
-        "GnssMeasurements differ from the bag's"
-    );
+    assert_same_messages("Imu", &encoded(&imu), &want_imu);
+    assert_same_messages("GnssMeasurements", &encoded(&gnss), &want_gnss);
 
     let seconds = |c: &Clock| f64::from(c.clock.sec) + f64::from(c.clock.nanosec) * 1e-9;
     let first_imu = &imu[0].header.stamp;
@@ -224,6 +235,7 @@ fn node_records_the_replay_solution_of_a_played_bag() {
         .arg(fixture())
         .args(["--rate", "2"])
         .args(["--wait-for", "/imu", "--wait-for", "/gnss/measurements"])
+        .args(["--delay", PLAYER_DELAY_S])
         .env("ROS_DOMAIN_ID", &domain)
         .env("RUST_LOG", "warn,rustdds=error")
         .stdout(Stdio::null())

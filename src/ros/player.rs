@@ -4,14 +4,23 @@
 //! The payloads are not decoded: each message's CDR body is re-published byte for byte,
 //! so any message type in the bag plays (not only the ones this package knows), and a
 //! subscriber receives exactly what was recorded.
+//!
+//! Choice: the topic writers are RustDDS data writers created on the node's participant,
+//! not ros2-client publishers, because only the RustDDS writer tells when a subscriber
+//! matched and when every reliable subscriber acknowledged the last message. The player
+//! waits for those acknowledgements before it exits (like `ros2 bag play
+//! --wait-for-all-acked`): a message lost on the wire near the end is repaired instead of
+//! dying with the process.
 
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::{Duration, Instant};
 
+use ros2_client::dds::rustdds::{
+    self, no_key::DataWriterCdr, DataWriterStatus, QosPolicies, StatusEvented,
+};
 use ros2_client::{
-    Context, ContextOptions, MessageTypeName, Name, Node, NodeName, NodeOptions, Publisher,
-    QosProfile,
+    Context, ContextOptions, MessageTypeName, Name, Node, NodeName, NodeOptions, QosProfile,
 };
 use serde::ser::SerializeTuple;
 use serde::{Serialize, Serializer};
@@ -28,6 +37,18 @@ pub const PLAYER_QUEUE_DEPTH: usize = 1000;
 
 /// How long `--wait-for` waits for a subscriber before giving up.
 pub const WAIT_FOR_SUBSCRIBER_TIMEOUT: Duration = Duration::from_secs(30);
+
+/// How long the player waits, after the last message of a pass, for every reliable
+/// subscriber to acknowledge what it was sent. Choice: RustDDS repeats its heartbeat
+/// every 100 ms while data is unacknowledged, so 5 s is many repair rounds; a subscriber
+/// that is gone or stalled longer only delays the exit, with a warning.
+pub const ACKNOWLEDGEMENT_TIMEOUT: Duration = Duration::from_secs(5);
+
+/// Poll period while waiting for a subscriber to match.
+const MATCH_POLL_PERIOD: Duration = Duration::from_millis(20);
+
+/// A data writer that publishes recorded CDR bodies unchanged.
+type RawWriter = DataWriterCdr<RawCdrBody>;
 
 /// How the bag is played.
 #[derive(Debug, Clone)]
@@ -141,16 +162,22 @@ fn reliable_qos() -> QosProfile {
     })
 }
 
-fn create_publisher<M: Serialize>(
-    node: &mut Node,
+fn create_topic(
+    node: &Node,
     topic: &str,
     type_name: MessageTypeName,
-) -> Result<Publisher<M>, PlayError> {
+) -> Result<rustdds::Topic, PlayError> {
     let name = Name::parse(topic).map_err(|_| PlayError::TopicName(topic.to_owned()))?;
-    let topic = node
-        .create_topic(&name, type_name, &reliable_qos())
-        .map_err(dds_error)?;
-    node.create_publisher::<M>(&topic, Some(reliable_qos()))
+    node.create_topic(&name, type_name, &reliable_qos())
+        .map_err(dds_error)
+}
+
+fn create_writer<M: Serialize>(
+    publisher: &rustdds::Publisher,
+    topic: &rustdds::Topic,
+) -> Result<DataWriterCdr<M>, PlayError> {
+    publisher
+        .create_datawriter_no_key::<M, _>(topic, Some(QosPolicies::from(&reliable_qos())))
         .map_err(dds_error)
 }
 
@@ -166,7 +193,7 @@ pub fn play(bag: &Path, options: &PlayOptions) -> Result<PlayReport, PlayError> 
     let reader = BagReader::open(bag)?;
     let context = Context::with_options(ContextOptions::new().domain_id(options.domain_id))
         .map_err(dds_error)?;
-    let mut node = context
+    let node = context
         .new_node(
             NodeName::new("/", "gnss_ins_player").map_err(dds_error)?,
             NodeOptions::new()
@@ -175,30 +202,37 @@ pub fn play(bag: &Path, options: &PlayOptions) -> Result<PlayReport, PlayError> 
         )
         .map_err(dds_error)?;
 
-    let mut publishers = BTreeMap::new();
+    let dds_publisher = context
+        .domain_participant()
+        .create_publisher(&QosPolicies::from(&reliable_qos()))
+        .map_err(dds_error)?;
+    let mut writers = BTreeMap::new();
     for info in reader.topics() {
         let type_name = message_type_name(&info.type_name).ok_or_else(|| PlayError::TypeName {
             topic: info.topic.clone(),
             type_name: info.type_name.clone(),
         })?;
-        let publisher = create_publisher::<RawCdrBody>(&mut node, &info.topic, type_name)?;
+        let topic = create_topic(&node, &info.topic, type_name)?;
+        let writer = create_writer::<RawCdrBody>(&dds_publisher, &topic)?;
         log::info!("playing {} ({})", info.topic, info.type_name);
-        publishers.insert(info.topic.clone(), publisher);
+        writers.insert(info.topic.clone(), writer);
     }
     let clock = if options.clock {
         let type_name = message_type_name(Clock::TYPE_NAME)
             .ok_or_else(|| PlayError::Dds("bad Clock type name".to_owned()))?;
-        Some(create_publisher::<Clock>(&mut node, "/clock", type_name)?)
+        let topic = create_topic(&node, "/clock", type_name)?;
+        Some(create_writer::<Clock>(&dds_publisher, &topic)?)
     } else {
         None
     };
 
-    wait_for_subscribers(&mut node, &publishers, options)?;
+    wait_for_subscribers(&writers, options)?;
     std::thread::sleep(options.delay);
 
     let mut report = PlayReport::default();
     loop {
-        play_once(&reader, &publishers, clock.as_ref(), options, &mut report)?;
+        play_once(&reader, &writers, clock.as_ref(), options, &mut report)?;
+        wait_for_acknowledgements(&writers);
         report.passes += 1;
         if !options.repeat {
             return Ok(report);
@@ -206,40 +240,56 @@ pub fn play(bag: &Path, options: &PlayOptions) -> Result<PlayReport, PlayError> 
     }
 }
 
-/// Waits until every `--wait-for` topic has a matched subscriber. The node's graph
-/// bookkeeping only advances while its spinner runs, so one runs meanwhile.
+/// Waits until every reliable subscriber of every topic acknowledged all it was sent,
+/// at most [`ACKNOWLEDGEMENT_TIMEOUT`] in all; warns about the topics still unacknowledged.
+fn wait_for_acknowledgements(writers: &BTreeMap<String, RawWriter>) {
+    let deadline = Instant::now() + ACKNOWLEDGEMENT_TIMEOUT;
+    for (topic, writer) in writers {
+        let left = deadline.saturating_duration_since(Instant::now());
+        match writer.wait_for_acknowledgments(left) {
+            Ok(true) => {}
+            Ok(false) => log::warn!(
+                "{topic}: not every subscriber acknowledged the last messages within {ACKNOWLEDGEMENT_TIMEOUT:?}"
+            ),
+            Err(e) => log::warn!("{topic}: cannot wait for acknowledgements: {e:?}"),
+        }
+    }
+}
+
+/// Waits until every `--wait-for` topic's writer has matched a subscriber, as its
+/// RustDDS status reports it.
 fn wait_for_subscribers(
-    node: &mut Node,
-    publishers: &BTreeMap<String, Publisher<RawCdrBody>>,
+    writers: &BTreeMap<String, RawWriter>,
     options: &PlayOptions,
 ) -> Result<(), PlayError> {
-    if options.wait_for_topics.is_empty() {
-        return Ok(());
-    }
-    let spinner = node.spinner().map_err(dds_error)?;
-    std::thread::spawn(move || smol::block_on(spinner.spin()));
+    let deadline = Instant::now() + WAIT_FOR_SUBSCRIBER_TIMEOUT;
     for topic in &options.wait_for_topics {
-        let publisher = publishers
+        let writer = writers
             .get(topic)
             .ok_or_else(|| PlayError::UnknownWaitTopic(topic.clone()))?;
-        let matched = smol::block_on(async {
-            let wait = futures::FutureExt::fuse(publisher.wait_for_subscription(node));
-            let timeout = futures::FutureExt::fuse(smol::Timer::after(WAIT_FOR_SUBSCRIBER_TIMEOUT));
-            futures::pin_mut!(wait, timeout);
-            futures::select! {
-                () = wait => true,
-                _ = timeout => false,
+        while !subscriber_matched(writer) {
+            if Instant::now() >= deadline {
+                return Err(PlayError::NoSubscriber(
+                    topic.clone(),
+                    WAIT_FOR_SUBSCRIBER_TIMEOUT,
+                ));
             }
-        });
-        if !matched {
-            return Err(PlayError::NoSubscriber(
-                topic.clone(),
-                WAIT_FOR_SUBSCRIBER_TIMEOUT,
-            ));
+            std::thread::sleep(MATCH_POLL_PERIOD);
         }
         log::info!("{topic}: subscriber matched");
     }
     Ok(())
+}
+
+/// Whether the writer's pending status events include a match with a subscriber.
+fn subscriber_matched(writer: &RawWriter) -> bool {
+    let mut matched = false;
+    while let Some(status) = writer.try_recv_status() {
+        if let DataWriterStatus::PublicationMatched { current, .. } = status {
+            matched |= current.count() > 0;
+        }
+    }
+    matched
 }
 
 fn count(map: &mut BTreeMap<String, u64>, key: &str) {
@@ -249,8 +299,8 @@ fn count(map: &mut BTreeMap<String, u64>, key: &str) {
 /// One pass over the bag in log-time order (file order for a bag without an index).
 fn play_once(
     reader: &BagReader,
-    publishers: &BTreeMap<String, Publisher<RawCdrBody>>,
-    clock: Option<&Publisher<Clock>>,
+    writers: &BTreeMap<String, RawWriter>,
+    clock: Option<&DataWriterCdr<Clock>>,
     options: &PlayOptions,
     report: &mut PlayReport,
 ) -> Result<(), PlayError> {
@@ -291,17 +341,17 @@ fn play_once(
             if clock_due {
                 last_clock_ns = Some(log_time_ns);
                 let time = ros_time(log_time_ns);
-                if let Err(e) = clock.publish(Clock { clock: time }) {
+                if let Err(e) = clock.write(Clock { clock: time }, None) {
                     log::warn!("/clock: publish failed: {e:?}");
                 }
             }
         }
-        let Some(publisher) = publishers.get(&topic) else {
+        let Some(writer) = writers.get(&topic) else {
             count(&mut report.skipped, "topic not in the bag's summary");
             continue;
         };
         match little_endian_body(&data) {
-            Ok(body) => match publisher.publish(RawCdrBody(body.to_vec())) {
+            Ok(body) => match writer.write(RawCdrBody(body.to_vec()), None) {
                 Ok(()) => count(&mut report.published, &topic),
                 Err(e) => {
                     log::warn!("{topic}: publish failed: {e:?}");
