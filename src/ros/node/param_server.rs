@@ -3,8 +3,8 @@
 //! `SetParametersAtomically` in, responses out.
 //!
 //! The parameters are the core configuration's (`section.key`, human units, the names of
-//! the parameter file) plus the node's own `use_sim_time`, `map_frame`, `base_frame` and
-//! `publish_tf`. A set request is validated like the parameter file; only
+//! the parameter file) plus the node's own `use_sim_time`, `map_frame`, `base_frame`,
+//! `publish_tf` and `queue_depth`. A set request is validated like the parameter file; only
 //! [`RUNTIME_PARAMETERS`] (and `use_sim_time`) are accepted while the node runs, every
 //! other parameter is read-only and a set is refused with the reason.
 
