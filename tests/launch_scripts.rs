@@ -129,7 +129,10 @@ fn launch_file_declares_the_nodes_parameters_and_passes_only_those_set() {
     not_set.sort_unstable();
     node.sort_unstable();
     assert_eq!(not_set, node);
-    assert!(printed.contains("remap gnss/velocity gnss/velocity"), "{printed}");
+    assert!(
+        printed.contains("remap gnss/velocity gnss/velocity"),
+        "{printed}"
+    );
     // Nothing set: only the params file, which then decides every node parameter.
     assert!(printed.contains("parameters []"), "{printed}");
 
@@ -197,9 +200,9 @@ fn shell_script_passes_node_parameters_as_p() {
         let set = format!("{name}:=x");
         let command = shell_command(&["ekf", &set, "-r", "__ns:=/robot"]).unwrap();
         assert!(
-            command.trim_end().ends_with(&format!(
-                "params/ekf.yaml -p {name}:=x -r __ns:=/robot"
-            )),
+            command
+                .trim_end()
+                .ends_with(&format!("params/ekf.yaml -p {name}:=x -r __ns:=/robot")),
             "{command}"
         );
     }
