@@ -6,6 +6,7 @@
 //! - [`cdr`]: `encode` / `decode` of a whole serialized ROS 2 payload (encapsulation
 //!   header + CDR body).
 //! - [`convert`]: wire messages -> core types (`GnssEpoch`, `ImuSample`) and ROS time.
+//! - [`fix_velocity`]: `gnss/fix` joined with its `gnss/velocity` (node and replay).
 //! - [`outbound`]: engine outputs -> Odometry, NavSatFix, NoiseEstimates.
 //! - [`bag`]: rosbag2-compatible MCAP bag writing and streaming reading.
 //! - [`args`]: the node's `--ros-args` command line; [`names`]: topic-name resolution.
@@ -16,6 +17,7 @@ pub mod args;
 pub mod bag;
 pub mod cdr;
 pub mod convert;
+pub mod fix_velocity;
 pub mod msg;
 pub mod names;
 pub mod node;

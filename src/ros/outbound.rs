@@ -2,7 +2,7 @@
 //! frame at the datum, twist in the body frame), its TF (tf2_msgs/TFMessage),
 //! sensor_msgs/NavSatFix and our NoiseEstimates (the covariance-diagnostic topic); and
 //! simulated inputs as Imu,
-//! GnssMeasurements and NavSatFix (for writing bags).
+//! GnssMeasurements, NavSatFix and the receiver velocity (for writing bags).
 
 use nalgebra::{Matrix3, SMatrix};
 
@@ -13,7 +13,7 @@ use crate::ins::error_state::{DV, GYRO_BIAS, GYRO_GM};
 use super::msg::{
     GnssMeasurements, Header, Imu, NavSatFix, NavSatStatus, NoiseEstimates, Odometry, Point, Pose,
     PoseWithCovariance, Quaternion, SatelliteMeasurement, SatelliteNoise, TFMessage, Time,
-    Transform, TransformStamped, Twist, TwistWithCovariance, Vector3,
+    Transform, TransformStamped, Twist, TwistWithCovariance, TwistWithCovarianceStamped, Vector3,
 };
 
 fn vector3(v: &nalgebra::Vector3<f64>) -> Vector3 {
@@ -273,6 +273,46 @@ pub fn receiver_fix(fix: &crate::engine::GnssFix, stamp: Time, frame_id: &str) -
     }
 }
 
+/// The receiver velocity of `fix` as `gnss/velocity` carries it (None when the fix has
+/// none): the ENU velocity as the twist's linear part, its covariance (when the fix has
+/// one) as the linear block, stamped like the fix. The angular part is unknown: zero, its
+/// covariance block −1 on the diagonal (the reader ignores it).
+pub fn receiver_velocity(
+    fix: &crate::engine::GnssFix,
+    stamp: Time,
+    frame_id: &str,
+) -> Option<TwistWithCovarianceStamped> {
+    let v = fix.velocity_enu_mps?;
+    let mut covariance = [0.0; 36];
+    if let Some(c) = fix.velocity_covariance_enu_m2_s2 {
+        for r in 0..3 {
+            for k in 0..3 {
+                covariance[6 * r + k] = c[(r, k)];
+            }
+        }
+    }
+    for k in 3..6 {
+        covariance[6 * k + k] = -1.0;
+    }
+    Some(TwistWithCovarianceStamped {
+        header: Header {
+            stamp,
+            frame_id: frame_id.to_owned(),
+        },
+        twist: TwistWithCovariance {
+            twist: Twist {
+                linear: vector3(&v),
+                angular: Vector3 {
+                    x: 0.0,
+                    y: 0.0,
+                    z: 0.0,
+                },
+            },
+            covariance,
+        },
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -368,5 +408,30 @@ mod tests {
             (forward - nalgebra::Vector3::y()).norm() < 1e-12,
             "{forward}"
         );
+    }
+
+    #[test]
+    fn receiver_velocity_reads_back_as_the_fixs_velocity() {
+        let mut fix = crate::engine::GnssFix {
+            t_s: 3.5,
+            position: Llh::from_degrees(40.0, -105.0, 1600.0),
+            position_covariance_enu_m2: None,
+            velocity_enu_mps: None,
+            velocity_covariance_enu_m2_s2: None,
+        };
+        let stamp = Time {
+            sec: 3,
+            nanosec: 500_000_000,
+        };
+        assert!(receiver_velocity(&fix, stamp, "gnss").is_none());
+        let c = Matrix3::new(0.01, 0.001, 0.0, 0.001, 0.02, 0.0, 0.0, 0.0, 0.04);
+        fix.velocity_enu_mps = Some(nalgebra::Vector3::new(1.5, -0.5, 0.1));
+        fix.velocity_covariance_enu_m2_s2 = Some(c);
+        let msg = receiver_velocity(&fix, stamp, "gnss").unwrap();
+        assert_eq!(msg.header.frame_id, "gnss");
+        let v = crate::ros::convert::GnssVelocity::try_from(&msg).unwrap();
+        assert_eq!(v.t_s, 3.5);
+        assert_eq!(Some(v.velocity_enu_mps), fix.velocity_enu_mps);
+        assert_eq!(v.covariance_enu_m2_s2, Some(c));
     }
 }

@@ -1,8 +1,10 @@
 //! A recorded bag as a stream of [`SessionInput`]s, read lazily: messages are decoded by
 //! their type on the configured topics; anything else is counted and skipped, and a
-//! message that does not decode is counted with its reason.
+//! message that does not decode is counted with its reason. Fixes are joined with the
+//! velocities of their stamps by the live node's code ([`FixVelocityJoin`]), driven by the
+//! bag's message order and IMU time as the node is by arrival order and IMU time.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, VecDeque};
 
 use nalgebra::Matrix3;
 
@@ -13,9 +15,11 @@ use crate::gnss::{Constellation, GnssEpoch, SatId};
 use crate::ins::ImuSample;
 use crate::ros::bag::BagMessages;
 use crate::ros::cdr;
-use crate::ros::convert::time_to_seconds;
+use crate::ros::convert::{time_to_seconds, GnssVelocity};
+use crate::ros::fix_velocity::{FixVelocityJoin, FramedFix, Joined, VelocityUse};
 use crate::ros::msg::{
     DiagnosticArray, GnssMeasurements, Imu, NavSatFix, NoiseEstimates, Odometry, RosMessage,
+    TwistWithCovarianceStamped,
 };
 
 use super::session::SessionInput;
@@ -26,6 +30,9 @@ pub struct BagTopics {
     pub imu: String,
     pub gnss: String,
     pub fix: String,
+    /// geometry_msgs/TwistWithCovarianceStamped receiver velocities, joined with the fix of
+    /// their stamp.
+    pub velocity: String,
     /// nav_msgs/Odometry reference in an ENU frame at `truth_datum` (None: no reference).
     pub truth: Option<String>,
     pub truth_datum: String,
@@ -40,6 +47,7 @@ impl Default for BagTopics {
             imu: IMU_TOPIC.to_owned(),
             gnss: GNSS_TOPIC.to_owned(),
             fix: FIX_TOPIC.to_owned(),
+            velocity: VELOCITY_TOPIC.to_owned(),
             truth: Some(TRUTH_TOPIC.to_owned()),
             truth_datum: TRUTH_DATUM_TOPIC.to_owned(),
             truth_noise: TRUTH_NOISE_TOPIC.to_owned(),
@@ -62,7 +70,24 @@ pub struct ReadProblems {
     pub undecodable: BTreeMap<String, u64>,
     /// Errors of the bag itself (corrupt chunks, truncation).
     pub bag_errors: Vec<String>,
+    /// What became of the velocities.
+    pub velocities: VelocityCounts,
 }
+
+/// What became of the receiver velocities of a bag (counted as the node counts them).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct VelocityCounts {
+    /// Joined with the fix of their stamp.
+    pub paired: u64,
+    /// Dropped for want of a fix of their stamp.
+    pub unpaired: u64,
+    /// Paired but in a frame neither [`REPLAY_MAP_FRAME`] nor their fix's: not used.
+    pub foreign_frame: u64,
+}
+
+/// The ENU frame a velocity of a bag may be given in (besides its fix's frame): the frame
+/// of the replay's Odometry, as the node's default `map_frame`.
+pub const REPLAY_MAP_FRAME: &str = "map";
 
 impl ReadProblems {
     /// Messages used on `topic`.
@@ -87,6 +112,8 @@ impl BagTopics {
             Some(GnssMeasurements::TYPE_NAME)
         } else if topic == self.fix || topic == self.truth_datum {
             Some(NavSatFix::TYPE_NAME)
+        } else if topic == self.velocity {
+            Some(TwistWithCovarianceStamped::TYPE_NAME)
         } else if self.truth.as_deref() == Some(topic) {
             Some(Odometry::TYPE_NAME)
         } else if topic == self.truth_noise {
@@ -105,6 +132,9 @@ pub struct BagInputs {
     topics: BagTopics,
     datum: Option<Llh>,
     problems: ReadProblems,
+    join: FixVelocityJoin,
+    /// Inputs of the last message, not yet handed on.
+    ready: VecDeque<SessionInput>,
 }
 
 impl BagInputs {
@@ -114,11 +144,29 @@ impl BagInputs {
             topics,
             datum: None,
             problems: ReadProblems::default(),
+            join: FixVelocityJoin::new(REPLAY_MAP_FRAME),
+            ready: VecDeque::new(),
         }
     }
 
-    pub fn problems(&self) -> &ReadProblems {
-        &self.problems
+    /// What was read and skipped so far.
+    pub fn problems(&self) -> ReadProblems {
+        let mut problems = self.problems.clone();
+        problems.velocities.unpaired = self.join.unpaired_velocities();
+        problems
+    }
+
+    /// Queues joined fixes as inputs, counting what became of their velocities.
+    fn queue_fixes(&mut self, joined: Vec<Joined>) {
+        for j in joined {
+            let counts = &mut self.problems.velocities;
+            match j.velocity {
+                VelocityUse::None => {}
+                VelocityUse::Paired => counts.paired += 1,
+                VelocityUse::ForeignFrame(_) => counts.foreign_frame += 1,
+            }
+            self.ready.push_back(SessionInput::Fix(j.fix));
+        }
     }
 
     /// Counts one message of `topic` in `map` under `key`.
@@ -126,8 +174,8 @@ impl BagInputs {
         *map.entry(key).or_insert(0) += 1;
     }
 
-    /// The input of one message; counts it as used or skipped (with the reason).
-    fn convert(&mut self, topic: &str, type_name: &str, data: &[u8]) -> Option<SessionInput> {
+    /// Queues the inputs of one message; counts it as used or skipped (with the reason).
+    fn convert(&mut self, topic: &str, type_name: &str, data: &[u8]) {
         let problems = &mut self.problems;
         match self.topics.expected_type(topic) {
             None => {
@@ -135,17 +183,15 @@ impl BagInputs {
                     &mut problems.unused_topics,
                     format!("{topic} ({type_name})"),
                 );
-                None
             }
             Some(expected) if expected != type_name => {
                 Self::count(
                     &mut problems.wrong_types,
                     format!("{topic}: {type_name}, expected {expected}"),
                 );
-                None
             }
             Some(_) => match self.convert_known(topic, data) {
-                Ok(input) => {
+                Ok(()) => {
                     // Choice: the count lookup by &str first avoids an allocation per
                     // message on the hot path (hundreds of thousands of IMU samples).
                     match self.problems.used_topics.get_mut(topic) {
@@ -154,25 +200,34 @@ impl BagInputs {
                             self.problems.used_topics.insert(topic.to_owned(), 1);
                         }
                     }
-                    input
                 }
                 Err(reason) => {
                     Self::count(&mut self.problems.undecodable, format!("{topic}: {reason}"));
-                    None
                 }
             },
         }
     }
 
-    /// The input of a message of the expected type on a topic this run uses: None for a
-    /// message that is used without giving an input (the datum, a fix without solution),
-    /// Err with the reason for one that does not decode or convert.
-    fn convert_known(&mut self, topic: &str, data: &[u8]) -> Result<Option<SessionInput>, String> {
+    /// Queues the inputs of a message of the expected type on a topic this run uses (none
+    /// for the datum, a fix without solution, a fix or velocity still waiting for its
+    /// partner); Err with the reason for one that does not decode or convert.
+    fn convert_known(&mut self, topic: &str, data: &[u8]) -> Result<(), String> {
+        let input = self.input_of(topic, data)?;
+        self.ready.extend(input);
+        Ok(())
+    }
+
+    /// The input of a message that gives at most one on its own (fixes and velocities are
+    /// queued through the join).
+    fn input_of(&mut self, topic: &str, data: &[u8]) -> Result<Option<SessionInput>, String> {
         let t = &self.topics;
         let stamp = |s: &crate::ros::msg::Time| time_to_seconds(s).map_err(|e| e.to_string());
         if topic == t.imu {
             let msg: Imu = decode(data)?;
             let sample = ImuSample::try_from(&msg).map_err(|e| e.to_string())?;
+            // As the node: fixes that waited long enough go before this sample.
+            let joined = self.join.on_time(sample.t_s);
+            self.queue_fixes(joined);
             return Ok(Some(SessionInput::Imu(sample)));
         }
         if topic == t.gnss {
@@ -185,10 +240,20 @@ impl BagInputs {
             if msg.status.status < 0 {
                 return Ok(None);
             }
-            return Ok(Some(SessionInput::Fix(fix_of(
-                &msg,
-                stamp(&msg.header.stamp)?,
-            ))));
+            let fix = FramedFix {
+                fix: fix_of(&msg, stamp(&msg.header.stamp)?),
+                frame_id: msg.header.frame_id,
+            };
+            let joined = self.join.on_fix(fix);
+            self.queue_fixes(joined);
+            return Ok(None);
+        }
+        if topic == t.velocity {
+            let msg: TwistWithCovarianceStamped = decode(data)?;
+            let velocity = GnssVelocity::try_from(&msg).map_err(|e| e.to_string())?;
+            let joined = self.join.on_velocity(velocity);
+            self.queue_fixes(joined);
+            return Ok(None);
         }
         if topic == t.truth_datum {
             let msg: NavSatFix = decode(data)?;
@@ -247,12 +312,11 @@ impl Iterator for BagInputs {
 
     fn next(&mut self) -> Option<SessionInput> {
         loop {
+            if let Some(input) = self.ready.pop_front() {
+                return Some(input);
+            }
             match self.messages.next()? {
-                Ok(m) => {
-                    if let Some(input) = self.convert(&m.topic, &m.type_name, &m.data) {
-                        return Some(input);
-                    }
-                }
+                Ok(m) => self.convert(&m.topic, &m.type_name, &m.data),
                 Err(e) => self.problems.bag_errors.push(e.to_string()),
             }
         }

@@ -34,6 +34,10 @@ pub enum Command {
         seed: u64,
         #[arg(long)]
         out: PathBuf,
+        /// Also write the receiver's velocities on /gnss/velocity
+        /// (geometry_msgs/TwistWithCovarianceStamped, paired with /gnss/fix by stamp).
+        #[arg(long)]
+        velocity: bool,
     },
     /// Stream a bag through the engine; write the solution; score it against a reference.
     Replay {
@@ -111,15 +115,20 @@ pub fn run(command: Command) -> Result<(), String> {
             scenario,
             seed,
             out,
+            velocity,
         } => {
             let scenario = load_scenario(&scenario, seed)?;
-            let summary = simulate::simulate(&scenario, &out).map_err(|e| e.to_string())?;
+            let options = simulate::SimulateOptions { velocity };
+            let summary =
+                simulate::simulate_with(&scenario, &out, options).map_err(|e| e.to_string())?;
             eprintln!(
-                "wrote {}: {} IMU samples, {} GNSS epochs, {} fixes, {} reference samples",
+                "wrote {}: {} IMU samples, {} GNSS epochs, {} fixes, {} velocities, {} reference \
+                 samples",
                 out.display(),
                 summary.imu,
                 summary.gnss,
                 summary.fixes,
+                summary.velocities,
                 summary.truth
             );
             Ok(())
@@ -285,6 +294,14 @@ fn print_problems(problems: &super::bag_inputs::ReadProblems, report: &SessionRe
     }
     for e in &problems.bag_errors {
         eprintln!("bag error: {e}");
+    }
+    let v = &problems.velocities;
+    if v.paired + v.unpaired + v.foreign_frame > 0 {
+        eprintln!(
+            "velocities: {} paired with their fix, {} without a fix of their stamp, {} in a \
+             foreign frame",
+            v.paired, v.unpaired, v.foreign_frame
+        );
     }
     if !report.rejected.is_empty() {
         let mut by_reason = std::collections::BTreeMap::new();

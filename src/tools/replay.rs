@@ -181,7 +181,7 @@ pub fn replay(
             source,
         })?;
     }
-    let problems = inputs.problems().clone();
+    let problems = inputs.problems();
     let report = session.finish();
     let summary = (!report.errors.is_empty()).then(|| report.summary(f64::NEG_INFINITY));
     Ok(ReplayResult {

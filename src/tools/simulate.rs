@@ -4,6 +4,10 @@
 //! - `/imu` sensor_msgs/Imu (REP-145, frame `imu_link`);
 //! - `/gnss/measurements` our GnssMeasurements (frame `gnss_antenna`);
 //! - `/gnss/fix` sensor_msgs/NavSatFix, a receiver-like single-point fix (loose coupling);
+//! - only with [`SimulateOptions::velocity`]: `/gnss/velocity`
+//!   geometry_msgs/TwistWithCovarianceStamped, the receiver's velocity of each fix that has
+//!   one (ENU, in the fix's frame as GNSS drivers send it), stamped like its fix and written
+//!   just after it;
 //! - `/ground_truth` nav_msgs/Odometry of the true IMU position in the ENU frame `map`
 //!   whose origin is the trajectory's start, written in `/ground_truth/datum`
 //!   (sensor_msgs/NavSatFix, once at t = 0);
@@ -23,7 +27,7 @@ use crate::ros::bag::{BagError, BagWriter};
 use crate::ros::convert::seconds_to_time;
 use crate::ros::msg::{
     DiagnosticArray, DiagnosticStatus, GnssMeasurements, Header, Imu, NavSatFix, NavSatStatus,
-    NoiseEstimates, Odometry, SatelliteNoise,
+    NoiseEstimates, Odometry, SatelliteNoise, TwistWithCovarianceStamped,
 };
 use crate::ros::outbound;
 use crate::sim::constellation::REFERENCE_EPOCH_GPS_TOW_S;
@@ -33,6 +37,7 @@ use crate::sim::scenario::{Scenario, ScenarioError, SimEvent};
 pub const IMU_TOPIC: &str = "/imu";
 pub const GNSS_TOPIC: &str = "/gnss/measurements";
 pub const FIX_TOPIC: &str = "/gnss/fix";
+pub const VELOCITY_TOPIC: &str = "/gnss/velocity";
 pub const TRUTH_TOPIC: &str = "/ground_truth";
 pub const TRUTH_DATUM_TOPIC: &str = "/ground_truth/datum";
 pub const TRUTH_NOISE_TOPIC: &str = "/ground_truth/noise";
@@ -55,7 +60,17 @@ pub struct SimulateSummary {
     pub imu: usize,
     pub gnss: usize,
     pub fixes: usize,
+    /// Messages on `/gnss/velocity` (0 unless asked for).
+    pub velocities: usize,
     pub truth: usize,
+}
+
+/// What a simulated bag carries beyond the default topics.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct SimulateOptions {
+    /// Also write the receiver's velocities on `/gnss/velocity`. Choice: opt-in, so bags
+    /// written before (the committed test fixture among them) are written unchanged.
+    pub velocity: bool,
 }
 
 fn stamp(t_s: f64) -> Result<crate::ros::msg::Time, SimulateError> {
@@ -66,12 +81,24 @@ fn log_time_ns(t_s: f64) -> u64 {
     (t_s * 1e9).round().max(0.0) as u64
 }
 
-/// Writes `scenario` to the bag at `out`.
+/// Writes `scenario` to the bag at `out` with the default topics.
 pub fn simulate(scenario: &Scenario, out: &Path) -> Result<SimulateSummary, SimulateError> {
+    simulate_with(scenario, out, SimulateOptions::default())
+}
+
+/// Writes `scenario` to the bag at `out` with the topics `options` ask for.
+pub fn simulate_with(
+    scenario: &Scenario,
+    out: &Path,
+    options: SimulateOptions,
+) -> Result<SimulateSummary, SimulateError> {
     let mut bag = BagWriter::create(out)?;
     bag.add_topic::<Imu>(IMU_TOPIC)?;
     bag.add_topic::<GnssMeasurements>(GNSS_TOPIC)?;
     bag.add_topic::<NavSatFix>(FIX_TOPIC)?;
+    if options.velocity {
+        bag.add_topic::<TwistWithCovarianceStamped>(VELOCITY_TOPIC)?;
+    }
     bag.add_topic::<Odometry>(TRUTH_TOPIC)?;
     bag.add_topic::<NavSatFix>(TRUTH_DATUM_TOPIC)?;
     bag.add_topic::<NoiseEstimates>(TRUTH_NOISE_TOPIC)?;
@@ -129,6 +156,14 @@ pub fn simulate(scenario: &Scenario, out: &Path) -> Result<SimulateSummary, Simu
                     ns,
                 )?;
                 summary.fixes += 1;
+                let velocity = options
+                    .velocity
+                    .then(|| outbound::receiver_velocity(&fix, st, "gnss_antenna"))
+                    .flatten();
+                if let Some(v) = velocity {
+                    bag.write(VELOCITY_TOPIC, &v, ns)?;
+                    summary.velocities += 1;
+                }
             }
         }
     }

@@ -6,6 +6,7 @@ use crate::earth::Llh;
 use crate::engine::{Engine, NotRuntimeTunable, Output, ResetReason, StatusEvent};
 use crate::ins::ImuSample;
 use crate::ros::convert::{seconds_to_time, time_to_seconds, GnssVelocity};
+use crate::ros::fix_velocity::{FixVelocityJoin, FramedFix, Joined, VelocityUse};
 use crate::ros::msg::{
     DiagnosticArray, DiagnosticStatus, GnssMeasurements, Header, Imu, KeyValue, NavSatFix,
     NoiseEstimates, Odometry, TFMessage, Time, TwistWithCovarianceStamped,
@@ -13,7 +14,6 @@ use crate::ros::msg::{
 use crate::ros::outbound;
 use crate::tools::bag_inputs::fix_of;
 
-use super::fix_pairing::{FixPairing, FramedFix, Released};
 use super::log_limit::LogLimiter;
 use super::params::OutputFrames;
 
@@ -125,7 +125,7 @@ pub struct NodeCore {
     gnss_frame: FrameLock,
     fix_frame: FrameLock,
     frames: OutputFrames,
-    pairing: FixPairing,
+    pairing: FixVelocityJoin,
 }
 
 impl NodeCore {
@@ -140,8 +140,8 @@ impl NodeCore {
             imu_frame: FrameLock::default(),
             gnss_frame: FrameLock::default(),
             fix_frame: FrameLock::default(),
+            pairing: FixVelocityJoin::new(&frames.map_frame),
             frames,
-            pairing: FixPairing::default(),
         }
     }
 
@@ -251,11 +251,8 @@ impl NodeCore {
     }
 
     /// Handles one velocity on `gnss/velocity` (loose coupling): it joins the fix of its
-    /// stamp (see [`super::fix_pairing`]).
-    ///
-    /// Convention: the twist is the ENU velocity (REP-105) when `header.frame_id` is the
-    /// map frame; a velocity in its fix's frame (what GNSS drivers such as ublox_gps send)
-    /// is read as ENU too. Any other frame is counted and the fix goes on without it.
+    /// stamp (see [`crate::engine::fix_pairing`] and [`FixVelocityJoin`]: in the map frame
+    /// or the fix's frame). Any other frame is counted and the fix goes on without it.
     pub fn on_velocity(&mut self, msg: &TwistWithCovarianceStamped) -> Vec<OutMsg> {
         self.counts.velocity_received += 1;
         let velocity = match GnssVelocity::try_from(msg) {
@@ -272,18 +269,20 @@ impl NodeCore {
         self.pairing.unpaired_velocities()
     }
 
-    /// Feeds released fixes (with their velocity when its frame is admissible).
-    fn push_fixes(&mut self, released: Vec<Released>) -> Vec<Output> {
+    /// Feeds joined fixes, counting what became of their velocities.
+    fn push_fixes(&mut self, joined: Vec<Joined>) -> Vec<Output> {
         let mut outputs = Vec::new();
-        for Released { fix, velocity } in released {
-            let FramedFix { mut fix, frame_id } = fix;
-            if let Some(v) = velocity {
-                if v.frame_id == self.frames.map_frame || v.frame_id == frame_id {
-                    self.counts.velocity_paired += 1;
-                    fix.velocity_enu_mps = Some(v.velocity_enu_mps);
-                    fix.velocity_covariance_enu_m2_s2 = v.covariance_enu_m2_s2;
-                } else {
-                    self.foreign_frame(Input::Velocity, &v.frame_id);
+        for Joined {
+            fix,
+            frame_id,
+            velocity,
+        } in joined
+        {
+            match velocity {
+                VelocityUse::None => {}
+                VelocityUse::Paired => self.counts.velocity_paired += 1,
+                VelocityUse::ForeignFrame(v_frame) => {
+                    self.foreign_frame(Input::Velocity, &v_frame);
                 }
             }
             match self.engine.push_fix(fix) {
@@ -670,19 +669,8 @@ mod tests {
 
     /// The velocity message of a simulated fix (ENU twist, the linear covariance block).
     fn velocity_of(fix: &crate::engine::GnssFix, frame_id: &str) -> TwistWithCovarianceStamped {
-        let mut msg = TwistWithCovarianceStamped::default();
-        msg.header.stamp = seconds_to_time(fix.t_s).unwrap();
-        msg.header.frame_id = frame_id.to_owned();
-        let v = fix.velocity_enu_mps.unwrap();
-        let l = &mut msg.twist.twist.linear;
-        (l.x, l.y, l.z) = (v[0], v[1], v[2]);
-        let c = fix.velocity_covariance_enu_m2_s2.unwrap();
-        for r in 0..3 {
-            for k in 0..3 {
-                msg.twist.covariance[6 * r + k] = c[(r, k)];
-            }
-        }
-        msg
+        let stamp = seconds_to_time(fix.t_s).unwrap();
+        outbound::receiver_velocity(fix, stamp, frame_id).unwrap()
     }
 
     #[test]
@@ -708,14 +696,15 @@ mod tests {
                 SimEvent::Fix(f) => {
                     fixes += 1;
                     let fix = outbound::receiver_fix(&f, stamp, "gnss");
-                    // Velocity in the map frame or in the fix's frame, before or after.
+                    // Velocity in the map frame or in the fix's frame, after or before
+                    // (after for the first: it pairs as well).
                     let mut velocity = velocity_of(&f, ["map", "gnss"][fixes % 2]);
                     match fixes {
                         3 => velocity.twist.twist.linear.x = f64::NAN,
                         5 => velocity.header.frame_id = "base_link".to_owned(),
                         _ => paired += 1,
                     }
-                    if fixes % 2 == 1 {
+                    if fixes % 2 == 0 {
                         out.extend(core.on_velocity(&velocity));
                         out.extend(core.on_fix(&fix));
                     } else {

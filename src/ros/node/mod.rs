@@ -9,7 +9,6 @@
 //! (tf2_msgs/TFMessage). Serves the parameter services ([`services`]).
 
 pub mod clock;
-pub mod fix_pairing;
 pub mod handler;
 pub mod input_stats;
 pub mod log_limit;
