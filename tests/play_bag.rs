@@ -1,7 +1,8 @@
 //! `gnss_ins play` over DDS: a subscriber in this process receives every Imu and
 //! GnssMeasurements message of the fixture bag, unchanged and in order, and /clock
 //! follows the bag's time; and the bag played into `gnss_ins_node --record` gives the
-//! Odometry that `gnss_ins replay` computes from the same bag.
+//! Odometry that `gnss_ins replay` computes from the same bag, tightly coupled and (on a
+//! simulated bag with `/gnss/velocity`) loosely coupled with receiver velocities.
 //!
 //! DDS traffic stays on this machine: the test re-executes itself inside a private
 //! network namespace that has only loopback (`unshare -n`, needs root).
@@ -14,7 +15,9 @@ use adaptive_gnss_ins::config::Config;
 use adaptive_gnss_ins::ros::bag::BagReader;
 use adaptive_gnss_ins::ros::cdr;
 use adaptive_gnss_ins::ros::msg::{Clock, GnssMeasurements, Imu, Odometry, RosMessage};
-use adaptive_gnss_ins::tools::replay::{replay, ReplayOptions, TruthSource};
+use adaptive_gnss_ins::sim::{Scenario, ScenarioSpec};
+use adaptive_gnss_ins::tools::replay::{replay, ReplayOptions, ReplayResult, TruthSource};
+use adaptive_gnss_ins::tools::simulate::{simulate_with, SimulateOptions};
 use ros2_client::{
     Context, ContextOptions, MessageTypeName, Name, Node, NodeName, NodeOptions, QosProfile,
     Subscription,
@@ -218,23 +221,68 @@ fn node_records_the_replay_solution_of_a_played_bag() {
     if reexec_in_private_netns("node_records_the_replay_solution_of_a_played_bag") {
         return;
     }
+    node_records_the_replay_solution(&fixture(), &[], &["/imu", "/gnss/measurements"], 1);
+}
+
+/// The loosely-coupled node with receiver velocities has its offline twin: the fixture's
+/// scenario simulated with `/gnss/velocity`, played into the loosely-coupled node (the
+/// `ekf_loose` preset: the defaults but `filter.coupling`), gives the Odometry of
+/// `gnss_ins replay` (which joins each velocity with its fix by the node's code, whichever
+/// of the two arrives first).
+#[test]
+fn loose_node_with_velocities_records_the_replay_solution() {
+    if reexec_in_private_netns("loose_node_with_velocities_records_the_replay_solution") {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let bag = dir.path().join("velocity.mcap");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let yaml = std::fs::read_to_string(root.join("tests/data/fixture_small.yaml")).unwrap();
+    let scenario = Scenario::new(ScenarioSpec::from_yaml(&yaml).unwrap(), 1).unwrap();
+    let summary = simulate_with(&scenario, &bag, SimulateOptions { velocity: true }).unwrap();
+    assert!(summary.velocities > 30, "{summary:?}");
+    let replayed = node_records_the_replay_solution(
+        &bag,
+        &[("filter.coupling", "loose")],
+        &["/imu", "/gnss/fix", "/gnss/velocity"],
+        2,
+    );
+    assert_eq!(
+        replayed.problems.velocities.paired,
+        summary.velocities as u64
+    );
+}
+
+/// Plays `bag` into `gnss_ins_node --record` (the default parameters but `overrides`,
+/// domain `DOMAIN_ID + domain_offset`) and checks its Odometry against `gnss_ins replay`
+/// of the bag with the same parameters; returns the replay's result.
+fn node_records_the_replay_solution(
+    bag: &Path,
+    overrides: &[(&str, &str)],
+    wait_for: &[&str],
+    domain_offset: u16,
+) -> ReplayResult {
     let dir = tempfile::tempdir().unwrap();
     let recorded = dir.path().join("node.mcap");
     let replayed = dir.path().join("replay.mcap");
-    let domain = (DOMAIN_ID + 1).to_string();
-    let node = Command::new(env!("CARGO_BIN_EXE_gnss_ins_node"))
-        .arg("--record")
+    let domain = (DOMAIN_ID + domain_offset).to_string();
+    let mut node = Command::new(env!("CARGO_BIN_EXE_gnss_ins_node"));
+    node.arg("--record")
         .arg(&recorded)
-        .args(["--ros-args", "-r", "__node:=recorder_test"])
+        .args(["--ros-args", "-r", "__node:=recorder_test"]);
+    for (name, value) in overrides {
+        node.arg("-p").arg(format!("{name}:={value}"));
+    }
+    let node = node
         .env("ROS_DOMAIN_ID", &domain)
         .env("RUST_LOG", "info,rustdds=error,ros2_client=warn")
         .spawn()
         .unwrap();
     let status = Command::new(env!("CARGO_BIN_EXE_gnss_ins"))
         .arg("play")
-        .arg(fixture())
+        .arg(bag)
         .args(["--rate", "2"])
-        .args(["--wait-for", "/imu", "--wait-for", "/gnss/measurements"])
+        .args(wait_for.iter().flat_map(|t| ["--wait-for", t]))
         .args(["--delay", PLAYER_DELAY_S])
         .env("ROS_DOMAIN_ID", &domain)
         .env("RUST_LOG", "warn,rustdds=error")
@@ -269,9 +317,13 @@ fn node_records_the_replay_solution_of_a_played_bag() {
         assert!(topics.contains(&want), "{want} not recorded: {topics:?}");
     }
 
-    replay(
-        &fixture(),
-        &Config::default(),
+    let mut config = Config::default();
+    for (name, value) in overrides {
+        config.set_parameter(name, value).unwrap();
+    }
+    let result = replay(
+        bag,
+        &config,
         TruthSource::None,
         &ReplayOptions {
             out_bag: Some(&replayed),
@@ -301,4 +353,5 @@ fn node_records_the_replay_solution_of_a_played_bag() {
         live.len()
     );
     assert!(worst <= 1e-9, "node and replay differ by {worst}");
+    result
 }
