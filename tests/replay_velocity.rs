@@ -79,8 +79,9 @@ fn replay_joins_every_velocity_with_its_fix_and_uses_it() {
     let from_t_s = first_t_s(&a).max(first_t_s(&b));
     let (sa, sb) = (a.report.summary(from_t_s), b.report.summary(from_t_s));
     eprintln!(
-        "velocity RMSE {:.4} m/s with velocities ({} epochs), {:.4} m/s without ({} epochs); \
-         position 3D {:.3} / {:.3} m",
+        "{} velocities paired; velocity RMSE {:.4} m/s with them ({} epochs), {:.4} m/s \
+         without ({} epochs); position 3D {:.3} / {:.3} m",
+        v.paired,
         sa.vel_rmse_3d_mps,
         sa.epochs,
         sb.vel_rmse_3d_mps,
