@@ -18,9 +18,7 @@ Run it inside a loopback-only network namespace with the venv of
 scripts/setup_test_peers.sh, ROS_DOMAIN_ID naming the node's domain.
 """
 
-import argparse
 import copy
-import json
 import math
 import sys
 import time
@@ -32,11 +30,12 @@ from cyclonedds.domain import DomainParticipant
 from cyclonedds.idl import IdlStruct
 from cyclonedds.idl.types import array, float64, uint8, uint16, uint32
 from cyclonedds.pub import DataWriter
-from cyclonedds.topic import Topic
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import cyclonedds_ros_types as ros  # noqa: E402
-from cyclonedds_peer import Checks, Peer, read_bag, wait_until  # noqa: E402
+from cyclonedds_peer import (  # noqa: E402
+    Checks, Peer, paced, peer_argument_parser, read_bag, report, wait_until)
+from cyclonedds_setup import writer, xcdr1_qos  # noqa: E402
 
 # Malformed messages sent of each kind, and the stream's bad-sample period.
 MALFORMED_EACH = 5
@@ -99,26 +98,19 @@ def send_until_counted(peer, write, key, checks):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.split('\n')[0])
-    parser.add_argument('--bag', required=True)
-    parser.add_argument('--namespace', required=True)
-    parser.add_argument('--node', required=True)
-    parser.add_argument('--speed', type=float, default=4.0)
-    args = parser.parse_args()
+    args = peer_argument_parser(__doc__, default_speed=4.0).parse_args()
     checks = Checks()
     summary = {}
     inputs, _, _ = read_bag(args.bag)
     peer = Peer(args.namespace, args.node)
     ns = args.namespace.rstrip('/')
-    qos = ros.xcdr1_qos(depth=1000)
+    qos = xcdr1_qos(depth=1000)
     # The malformed types need their own participant: one participant has one type per
     # topic.
     liar = DomainParticipant(peer.participant.domain_id)
-    bad_imu = DataWriter(liar, Topic(liar, f'rt{ns}/imu', TruncatedImu, qos=qos), qos=qos)
-    bad_gnss = DataWriter(liar, Topic(liar, f'rt{ns}/gnss/measurements', LyingGnss, qos=qos),
-                          qos=qos)
-    bad_fix = DataWriter(liar, Topic(liar, f'rt{ns}/gnss/fix', ShortCovarianceFix, qos=qos),
-                         qos=qos)
+    bad_imu = writer(liar, f'rt{ns}/imu', TruncatedImu, qos)
+    bad_gnss = writer(liar, f'rt{ns}/gnss/measurements', LyingGnss, qos)
+    bad_fix = writer(liar, f'rt{ns}/gnss/fix', ShortCovarianceFix, qos)
     second_imu = DataWriter(peer.participant, peer.imu.topic, qos=qos)
     if not checks.that(wait_until(peer.matched, 30.0), 'the node was not discovered'):
         return report(summary, checks)
@@ -156,15 +148,7 @@ def main():
     peer.received['odometry'].clear()
     peer.received['fix'].clear()
     imu_count = 0
-    t0_ns, start = inputs[0][0], time.monotonic()
-    previous = None
-    for t_ns, topic, message in inputs:
-        wait = (t_ns - t0_ns) * 1e-9 / args.speed - (time.monotonic() - start)
-        if previous is not None and topic != previous:
-            wait = max(wait, 0.02)
-        previous = topic
-        if wait > 0:
-            time.sleep(wait)
+    for _, topic, message in paced(inputs, args.speed, switch_gap_s=0.02):
         if topic != '/imu':
             peer.gnss.write(message)
             continue
@@ -227,14 +211,6 @@ def main():
 
 def seconds_of(message):
     return message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
-
-
-def report(summary, checks):
-    summary['failures'] = checks.failures
-    print(json.dumps(summary, indent=1, default=str))
-    for failure in checks.failures:
-        print(f'FAILED: {failure}', file=sys.stderr)
-    return 1 if checks.failures else 0
 
 
 if __name__ == '__main__':

@@ -13,7 +13,6 @@ network namespace with the venv of scripts/setup_test_peers.sh, e.g.
     --bag tests/data/fixture_small.mcap --namespace /lat --node ins --speed 2; kill %1'
 """
 
-import argparse
 import json
 import sys
 import threading
@@ -21,16 +20,12 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from cyclonedds_peer import Checks, Peer, handshake, read_bag, wait_until  # noqa: E402
+from cyclonedds_peer import (  # noqa: E402
+    Checks, Peer, handshake, paced, peer_argument_parser, read_bag, wait_until)
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.split('\n')[0])
-    parser.add_argument('--bag', required=True)
-    parser.add_argument('--namespace', required=True)
-    parser.add_argument('--node', required=True)
-    parser.add_argument('--speed', type=float, default=2.0)
-    args = parser.parse_args()
+    args = peer_argument_parser(__doc__, default_speed=2.0).parse_args()
     inputs, _, _ = read_bag(args.bag)
     peer = Peer(args.namespace, args.node)
     checks = Checks()
@@ -48,11 +43,7 @@ def main():
 
     receiver = threading.Thread(target=receive)
     receiver.start()
-    t0_ns, start = inputs[0][0], time.monotonic()
-    for t_ns, topic, message in inputs:
-        wait = (t_ns - t0_ns) * 1e-9 / args.speed - (time.monotonic() - start)
-        if wait > 0:
-            time.sleep(wait)
+    for _, topic, message in paced(inputs, args.speed):
         if topic == '/imu':
             stamp = (message.header.stamp.sec, message.header.stamp.nanosec)
             written[stamp] = time.perf_counter()

@@ -26,19 +26,15 @@ import csv
 import importlib.metadata
 import json
 import math
-import os
 import sys
 import time
 from pathlib import Path
 
-from cyclonedds.domain import DomainParticipant
-from cyclonedds.pub import DataWriter
-from cyclonedds.sub import DataReader
-from cyclonedds.topic import Topic
 from rosbags.highlevel import AnyReader
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import cyclonedds_ros_types as ros  # noqa: E402  (the tools directory is not a package)
+from cyclonedds_setup import reader, ros_domain_participant, writer, xcdr1_qos  # noqa: E402
 
 WGS84_A_M = 6378137.0
 WGS84_F = 1.0 / 298.257223563
@@ -139,27 +135,24 @@ class Peer:
     """The Cyclone DDS participant with the node's topics."""
 
     def __init__(self, namespace, node):
-        domain = int(os.environ.get('ROS_DOMAIN_ID', '0') or 0)
-        self.participant = DomainParticipant(domain)
-        qos = ros.xcdr1_qos(depth=100_000)
+        self.participant = ros_domain_participant()
+        qos = xcdr1_qos(depth=100_000)
         ns = namespace.rstrip('/')
 
-        def topic(name, kind):
-            return Topic(self.participant, 'rt' + name, kind, qos=qos)
+        def ros_writer(name, kind):
+            return writer(self.participant, 'rt' + name, kind, qos)
 
-        self.imu = DataWriter(self.participant, topic(f'{ns}/imu', ros.Imu), qos=qos)
-        self.gnss = DataWriter(self.participant,
-                               topic(f'{ns}/gnss/measurements', ros.GnssMeasurements), qos=qos)
-        self.odometry = DataReader(self.participant, topic(f'{ns}/odometry', ros.Odometry),
-                                   qos=qos)
-        self.fix = DataReader(self.participant, topic(f'{ns}/fix', ros.NavSatFix), qos=qos)
-        self.noise = DataReader(self.participant,
-                                topic(f'{ns}/{node}/noise_estimates', ros.NoiseEstimates),
-                                qos=qos)
-        self.diagnostics = DataReader(self.participant,
-                                      topic('/diagnostics', ros.DiagnosticArray), qos=qos)
-        self.clock = DataWriter(self.participant, topic('/clock', ros.Clock), qos=qos)
-        self.rosout = DataReader(self.participant, topic('/rosout', ros.Log), qos=qos)
+        def ros_reader(name, kind):
+            return reader(self.participant, 'rt' + name, kind, qos)
+
+        self.imu = ros_writer(f'{ns}/imu', ros.Imu)
+        self.gnss = ros_writer(f'{ns}/gnss/measurements', ros.GnssMeasurements)
+        self.odometry = ros_reader(f'{ns}/odometry', ros.Odometry)
+        self.fix = ros_reader(f'{ns}/fix', ros.NavSatFix)
+        self.noise = ros_reader(f'{ns}/{node}/noise_estimates', ros.NoiseEstimates)
+        self.diagnostics = ros_reader('/diagnostics', ros.DiagnosticArray)
+        self.clock = ros_writer('/clock', ros.Clock)
+        self.rosout = ros_reader('/rosout', ros.Log)
         self.received = {'odometry': [], 'fix': [], 'noise': [], 'diagnostics': [],
                          'rosout': []}
 
@@ -211,6 +204,22 @@ def handshake(peer, checks):
                        'the node never counted the NaN IMU sample and the empty GNSS epoch')
 
 
+def paced(inputs, speed, switch_gap_s=0.0):
+    """Yields the time-ordered `inputs` (t_ns, topic, message) each when its bag time since
+    the first, divided by `speed`, has passed, and at least `switch_gap_s` after the one
+    before where the topic changes."""
+    t0_ns, start = inputs[0][0], time.monotonic()
+    previous = None
+    for t_ns, topic, message in inputs:
+        wait = (t_ns - t0_ns) * 1e-9 / speed - (time.monotonic() - start)
+        if previous is not None and topic != previous:
+            wait = max(wait, switch_gap_s)
+        previous = topic
+        if wait > 0:
+            time.sleep(wait)
+        yield t_ns, topic, message
+
+
 def stream(peer, inputs, speed, clock_every):
     """Publishes the inputs paced at `speed` times real time; returns counts per topic.
 
@@ -218,13 +227,7 @@ def stream(peer, inputs, speed, clock_every):
     sample of the same stamp in either order: the engine's result does not depend on it,
     and the node must still equal `gnss_ins replay` exactly."""
     sent = {'/imu': 0, '/gnss/measurements': 0}
-    t0_ns = inputs[0][0]
-    start = time.monotonic()
-    for t_ns, topic, message in inputs:
-        due = (t_ns - t0_ns) * 1e-9 / speed
-        wait = due - (time.monotonic() - start)
-        if wait > 0:
-            time.sleep(wait)
+    for _, topic, message in paced(inputs, speed):
         (peer.imu if topic == '/imu' else peer.gnss).write(message)
         sent[topic] += 1
         # As `ros2 bag play --clock`: the bag's time on /clock (every `clock_every` IMU
@@ -338,12 +341,19 @@ def check_diagnostics(checks, diagnostics, node_fqn, sent, bad_imu):
     return {'count': len(diagnostics), 'last': values}
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__.split('\n')[0])
+def peer_argument_parser(doc, default_speed):
+    """The arguments of every peer script: the bag to play, the node's namespace and name,
+    and the playback speed (times real time); described by the first line of `doc`."""
+    parser = argparse.ArgumentParser(description=doc.split('\n')[0])
     parser.add_argument('--bag', required=True)
     parser.add_argument('--namespace', required=True)
     parser.add_argument('--node', required=True)
-    parser.add_argument('--speed', type=float, default=4.0)
+    parser.add_argument('--speed', type=float, default=default_speed)
+    return parser
+
+
+def main():
+    parser = peer_argument_parser(__doc__, default_speed=4.0)
     parser.add_argument('--variant', default='ekf')
     parser.add_argument('--golden', help='replay CSV of the same bag to compare the fixes with')
     parser.add_argument('--parameters', action='store_true')

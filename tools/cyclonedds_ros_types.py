@@ -4,8 +4,8 @@ Written by hand from the .msg definitions (ROS 2 Jazzy and this repository's msg
 an implementation independent of the node's Rust structs reads and writes the same bytes.
 DDS type names follow the ROS 2 convention `pkg::msg::dds_::Name_`; topics are `rt/...`,
 service request and reply topics `rq/...Request` and `rr/...Reply`. Every struct is final
-(plain CDR, no member headers), and writers must use XCDR1 (`XCDR1_QOS`), which is what
-ROS 2 peers and ros2-client speak.
+(plain CDR, no member headers), and writers must use XCDR1 (`cyclonedds_setup.xcdr1_qos`),
+which is what ROS 2 peers and ros2-client speak.
 """
 
 from dataclasses import dataclass, field
@@ -14,8 +14,6 @@ from cyclonedds.idl import IdlStruct
 import cyclonedds.idl.annotations as annotate
 from cyclonedds.idl.types import array, float32, float64, int8, int32, int64, sequence
 from cyclonedds.idl.types import uint8, uint16, uint32, uint64
-from cyclonedds.qos import Policy, Qos
-from cyclonedds.util import duration
 
 
 def _name(package: str, kind: str, name: str) -> str:
@@ -239,18 +237,6 @@ class NoiseEstimates(IdlStruct, typename=_name('adaptive_gnss_ins', 'msg', 'Nois
     chi2_threshold: float64 = 0.0
     q_scale: float64 = 0.0
     nis: float64 = 0.0
-
-
-def xcdr1_qos(depth: int) -> Qos:
-    """Reliable, volatile, keep-last `depth`, XCDR1 data representation."""
-    return Qos(
-        Policy.Reliability.Reliable(max_blocking_time=duration(seconds=1)),
-        Policy.Durability.Volatile,
-        Policy.History.KeepLast(depth),
-        Policy.DataRepresentation(use_cdrv0_representation=True),
-    )
-
-
 
 
 # --- rcl_interfaces: parameters and their services ---

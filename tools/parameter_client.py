@@ -9,11 +9,8 @@ the rest read-only) and leaves every parameter as it found it.
 import random
 import time
 
-from cyclonedds.pub import DataWriter
-from cyclonedds.sub import DataReader
-from cyclonedds.topic import Topic
-
 import cyclonedds_ros_types as ros
+from cyclonedds_setup import reader, writer, xcdr1_qos
 
 # A reply lost because the node's reply writer had not yet matched our reader is
 # retried with a new sequence number.
@@ -25,14 +22,10 @@ class ServiceClient:
     """One service: a request writer and a reply reader matched by the request header."""
 
     def __init__(self, participant, service, request_type, response_type):
-        qos = ros.xcdr1_qos(depth=10)
+        qos = xcdr1_qos(depth=10)
         self.name = service
-        self.writer = DataWriter(
-            participant, Topic(participant, f'rq{service}Request', request_type, qos=qos),
-            qos=qos)
-        self.reader = DataReader(
-            participant, Topic(participant, f'rr{service}Reply', response_type, qos=qos),
-            qos=qos)
+        self.writer = writer(participant, f'rq{service}Request', request_type, qos)
+        self.reader = reader(participant, f'rr{service}Reply', response_type, qos)
         self.guid = random.getrandbits(63)
         self.sequence = 0
         self.latencies_s = []
