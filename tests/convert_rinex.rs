@@ -3,7 +3,7 @@
 //! GnssMeasurements message carrying the file's pseudo-ranges and the satellite states,
 //! and the modes RINEX cannot serve are refused with a clear error.
 
-use std::path::{Path, PathBuf};
+mod walk_0827_support;
 
 use adaptive_gnss_ins::gnss::ionosphere::IonosphereMode;
 use adaptive_gnss_ins::gnss::rinex_obs::parse_rinex_obs;
@@ -14,17 +14,11 @@ use adaptive_gnss_ins::tools::convert::{
     convert, ConvertError, ConvertOptions, EphemerisMode, GnssSource, TruthInput,
 };
 
-fn data(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data/walk_0827")
-        .join(name)
-}
-
 fn options(ionosphere: IonosphereMode, truth: TruthInput) -> ConvertOptions {
     ConvertOptions {
         gnss: GnssSource::Rinex {
-            obs: data("walk_1730.obs"),
-            nav: data("walk_1730.nav"),
+            obs: walk_0827_support::path("walk_1730.obs"),
+            nav: walk_0827_support::path("walk_1730.nav"),
         },
         imu: None,
         truth,
@@ -40,7 +34,7 @@ fn rinex_epochs_become_gnss_measurements() {
     let bag = dir.path().join("rinex.mcap");
     let summary = convert(&options(IonosphereMode::Broadcast, TruthInput::None), &bag).unwrap();
 
-    let text = std::fs::read_to_string(data("walk_1730.obs")).unwrap();
+    let text = std::fs::read_to_string(walk_0827_support::path("walk_1730.obs")).unwrap();
     let obs = parse_rinex_obs(&text).unwrap();
     assert_eq!(summary.gnss_epochs + summary.empty_epochs, obs.epochs.len());
     // The navigation file holds 4 GPS ephemerides: most epochs see all four.

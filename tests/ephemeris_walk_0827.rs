@@ -1,30 +1,15 @@
 //! Broadcast ephemerides of the walk_0827 log: the UBX-SFRBX decoding against convbin's
 //! RINEX navigation file, and satellite positions against RTKLIB.
 
+mod walk_0827_support;
+
 use adaptive_gnss_ins::gnss::ephemeris::{GpsTime, GroupDelay, KeplerianEphemeris};
 use adaptive_gnss_ins::gnss::rinex_nav::parse_rinex_nav;
 use adaptive_gnss_ins::gnss::ubx::read_ubx_log;
 use adaptive_gnss_ins::gnss::{Constellation, SatId};
 
-fn data_path(name: &str) -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data/walk_0827")
-        .join(name)
-}
-
-fn read_data(name: &str) -> Vec<u8> {
-    let path = data_path(name);
-    std::fs::read(&path).unwrap_or_else(|e| {
-        panic!(
-            "test data {} is missing ({e}): the repository expects the shared/ data folder \
-             beside the crate (../shared/data/walk_0827)",
-            path.display()
-        )
-    })
-}
-
 fn rinex() -> Vec<KeplerianEphemeris> {
-    let text = String::from_utf8(read_data("walk_1730.nav")).unwrap();
+    let text = walk_0827_support::read_text("walk_1730.nav");
     let nav = parse_rinex_nav(&text).unwrap();
     assert_eq!(nav.skipped_records, 5, "SBAS records");
     assert_eq!(nav.klobuchar, None);
@@ -102,7 +87,7 @@ fn rinex_file_holds_four_gps_and_eight_beidou_ephemerides() {
 
 #[test]
 fn ubx_decoded_ephemerides_equal_the_rinex_ones() {
-    let log = read_ubx_log(&read_data("gnss_1730.ubx"));
+    let log = read_ubx_log(&walk_0827_support::read("gnss_1730.ubx"));
     let mut compared = 0;
     for r in rinex() {
         let decoded = log

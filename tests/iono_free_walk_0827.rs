@@ -2,6 +2,8 @@
 //! (u-blox RAWX: GPS L1 C/A + L2C, Galileo E1 + E5a), checked against the raw
 //! measurements, the ICD group-delay relations and the receiver's RTK solution.
 
+mod walk_0827_support;
+
 use adaptive_gnss_ins::earth::{llh_to_ecef, rot_ecef_to_enu, Llh};
 use adaptive_gnss_ins::gnss::ephemeris::{iono_free_coefficients, GroupDelay, RangingCode, Signal};
 use adaptive_gnss_ins::gnss::ionosphere::IonosphereMode;
@@ -10,16 +12,7 @@ use adaptive_gnss_ins::gnss::ubx::{build_epoch_with, read_ubx_log, sat_id, signa
 use nalgebra::Vector3;
 
 fn log() -> UbxLog {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data/walk_0827/gnss_1730.ubx");
-    let bytes = std::fs::read(&path).unwrap_or_else(|e| {
-        panic!(
-            "test data {} is missing ({e}): the repository expects the shared/ data folder \
-             beside the crate",
-            path.display()
-        )
-    });
-    read_ubx_log(&bytes)
+    read_ubx_log(&walk_0827_support::read("gnss_1730.ubx"))
 }
 
 #[test]

@@ -2,6 +2,8 @@
 //! every epoch flag, malformed lines with their line numbers, mutated input that must
 //! never panic, and the conversion into the epochs the UBX path builds.
 
+mod walk_0827_support;
+
 use adaptive_gnss_ins::gnss::ephemeris::{EphemerisStore, GpsTime};
 use adaptive_gnss_ins::gnss::rinex_nav::parse_rinex_nav;
 use adaptive_gnss_ins::gnss::rinex_obs::{
@@ -12,23 +14,6 @@ use adaptive_gnss_ins::gnss::ubx::{build_epoch, read_ubx_log};
 use adaptive_gnss_ins::gnss::{Constellation, SatId};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-
-fn read_data(name: &str) -> Vec<u8> {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data/walk_0827")
-        .join(name);
-    std::fs::read(&path).unwrap_or_else(|e| {
-        panic!(
-            "test data {} is missing ({e}): the repository expects the shared/ data folder \
-             beside the crate (../shared/data/walk_0827)",
-            path.display()
-        )
-    })
-}
-
-fn read_text(name: &str) -> String {
-    String::from_utf8(read_data(name)).expect("RINEX files are ASCII")
-}
 
 fn code(text: &str) -> ObsCode {
     ObsCode::parse(text).unwrap()
@@ -42,7 +27,7 @@ fn gps(prn: u16) -> SatId {
 }
 
 fn store() -> EphemerisStore {
-    let nav = parse_rinex_nav(&read_text("walk_1730.nav")).unwrap();
+    let nav = parse_rinex_nav(&walk_0827_support::read_text("walk_1730.nav")).unwrap();
     let mut store = EphemerisStore::new();
     for e in nav.ephemerides {
         store.insert(e);
@@ -52,7 +37,7 @@ fn store() -> EphemerisStore {
 
 #[test]
 fn walk_1730_header_and_records() {
-    let obs = parse_rinex_obs(&read_text("walk_1730.obs")).unwrap();
+    let obs = parse_rinex_obs(&walk_0827_support::read_text("walk_1730.obs")).unwrap();
     let h = &obs.header;
     assert_eq!(h.version, 3.04);
     assert_eq!(h.file_system, 'M');
@@ -321,7 +306,7 @@ fn mutate(text: &str, rng: &mut ChaCha8Rng) -> String {
 
 #[test]
 fn mutated_and_truncated_input_never_panics() {
-    let full = read_text("walk_1730.obs");
+    let full = walk_0827_support::read_text("walk_1730.obs");
     // The header and the first 20 epochs (about 380 lines).
     let sample: String = full
         .lines()
@@ -357,9 +342,9 @@ fn mutated_and_truncated_input_never_panics() {
 
 #[test]
 fn rinex_epochs_equal_the_ubx_epochs_they_were_converted_from() {
-    let obs = parse_rinex_obs(&read_text("walk_1730.obs")).unwrap();
+    let obs = parse_rinex_obs(&walk_0827_support::read_text("walk_1730.obs")).unwrap();
     let store = store();
-    let log = read_ubx_log(&read_data("gnss_1730.ubx"));
+    let log = read_ubx_log(&walk_0827_support::read("gnss_1730.ubx"));
     let mut compared = 0;
     assert_eq!(obs.epochs.len(), log.rawx.len());
     for (epoch, raw) in obs.epochs.iter().zip(&log.rawx) {

@@ -6,6 +6,8 @@
 //! The agreement measured is the 3D distance between the two ECEF positions of each
 //! epoch (not only horizontal).
 
+mod walk_0827_support;
+
 use adaptive_gnss_ins::earth::SPEED_OF_LIGHT_M_S;
 use adaptive_gnss_ins::gnss::atmosphere::TroposphereModel;
 use adaptive_gnss_ins::gnss::ephemeris::GpsTime;
@@ -28,24 +30,6 @@ const MAX_RMS_M: f64 = 0.5;
 /// fallback Klobuchar coefficients 3.5 m.
 const MAX_EPOCH_DIFFERENCE_M: f64 = 0.01;
 
-fn read_text(path: std::path::PathBuf) -> String {
-    std::fs::read_to_string(&path).unwrap_or_else(|e| {
-        panic!(
-            "{} is missing ({e}): the repository expects the shared/ data folder beside \
-             the crate (../shared/data/walk_0827)",
-            path.display()
-        )
-    })
-}
-
-fn shared(name: &str) -> String {
-    read_text(
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../shared/data/walk_0827")
-            .join(name),
-    )
-}
-
 /// One solution line of an RTKLIB .pos file written with `out-solformat = xyz` and
 /// `out-timeform = tow`: GPS week, TOW (s), x, y, z (m), Q, ns, ...
 struct RtklibSolution {
@@ -56,11 +40,11 @@ struct RtklibSolution {
 }
 
 fn rtklib(name: &str) -> Vec<RtklibSolution> {
-    let text = read_text(
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("tests/data/rnx2rtkp_walk_1730")
-            .join(name),
-    );
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/rnx2rtkp_walk_1730")
+        .join(name);
+    let text = std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
     text.lines()
         .filter(|l| !l.starts_with('%') && !l.trim().is_empty())
         .map(|l| {
@@ -77,8 +61,8 @@ fn rtklib(name: &str) -> Vec<RtklibSolution> {
 }
 
 fn ours(options: &RinexSppOptions) -> Vec<RinexSppEpoch> {
-    let obs = parse_rinex_obs(&shared("walk_1730.obs")).unwrap();
-    let nav = parse_rinex_nav(&shared("walk_1730.nav")).unwrap();
+    let obs = parse_rinex_obs(&walk_0827_support::read_text("walk_1730.obs")).unwrap();
+    let nav = parse_rinex_nav(&walk_0827_support::read_text("walk_1730.nav")).unwrap();
     assert_eq!(nav.klobuchar, None, "the file has no ION ALPHA/BETA");
     solve_rinex_spp(&obs, &nav, options)
 }
@@ -197,7 +181,7 @@ fn spp_matches_rnx2rtkp_without_atmosphere() {
 
 #[test]
 fn spp_rinex_tool_writes_one_line_per_epoch() {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/walk_0827");
+    let root = walk_0827_support::dir();
     let dir = tempfile::tempdir().unwrap();
     let csv = dir.path().join("spp.csv");
     let options = RinexSppOptions::rtklib_single_brdc_saas();

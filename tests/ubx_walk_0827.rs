@@ -1,6 +1,8 @@
 //! UBX decoding and single-point positioning on the real walk_0827 recording (u-blox
 //! RAWX/SFRBX/NAV-PVT), against the receiver's own RTK solution.
 
+mod walk_0827_support;
+
 use std::collections::BTreeMap;
 
 use adaptive_gnss_ins::earth::{llh_to_ecef, rot_ecef_to_enu, Llh};
@@ -9,21 +11,8 @@ use adaptive_gnss_ins::gnss::ubx::{build_epoch, read_ubx_log, BuiltEpoch, NavPvt
 use adaptive_gnss_ins::gnss::Constellation;
 use nalgebra::Vector3;
 
-fn read_data(name: &str) -> Vec<u8> {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data/walk_0827")
-        .join(name);
-    std::fs::read(&path).unwrap_or_else(|e| {
-        panic!(
-            "test data {} is missing ({e}): the repository expects the shared/ data folder \
-             beside the crate (../shared/data/walk_0827)",
-            path.display()
-        )
-    })
-}
-
 fn log() -> UbxLog {
-    read_ubx_log(&read_data("gnss_1730.ubx"))
+    read_ubx_log(&walk_0827_support::read("gnss_1730.ubx"))
 }
 
 /// The NAV-PVT solution nearest in time to the epoch (within 50 ms: the receiver's

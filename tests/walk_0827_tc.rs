@@ -2,6 +2,8 @@
 //! `gnss_ins convert` code and run through the tightly-coupled EKF on the engine path of
 //! `gnss_ins compare`, against the receiver's RTK solution (its fixed epochs).
 
+mod walk_0827_support;
+
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
@@ -51,13 +53,9 @@ const IMU_TO_FLU_RPY_DEG: [f64; 3] = [0.0, 0.0, 90.0];
 /// here (a datum offset of the reference would do it; see the README).
 const TC_EKF_FIXED_HORIZONTAL_BUDGET_M: f64 = 7.0;
 
-fn data() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/walk_0827")
-}
-
 /// The conversion `gnss_ins convert` does with the README's command line.
 fn options() -> ConvertOptions {
-    let d = data();
+    let d = walk_0827_support::dir();
     ConvertOptions {
         gnss: GnssSource::Ubx(d.join("gnss_1730.ubx")),
         imu: Some(ImuInput {
