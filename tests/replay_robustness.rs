@@ -98,6 +98,23 @@ fn copy_fixture(
     writer.finish().unwrap();
 }
 
+/// Copies the fixture to `out` with every /imu message handled as `imu` says, the other
+/// messages kept.
+fn copy_fixture_imu_as(out: &Path, imu: impl Fn() -> Copy) {
+    copy_fixture(
+        out,
+        BagWriteOptions::default(),
+        |_| {},
+        |topic, _| {
+            if topic == "/imu" {
+                imu()
+            } else {
+                Copy::Keep
+            }
+        },
+    );
+}
+
 #[test]
 fn a_truncated_bag_gives_the_solutions_before_the_cut_and_names_the_damage() {
     let full = replay_bag(&fixture_bag()).unwrap();
@@ -260,18 +277,7 @@ fn unknown_topics_wrong_types_and_undecodable_messages_are_counted_and_skipped()
 fn a_bag_without_imu_fails_with_a_clear_message_and_a_non_zero_exit() {
     let dir = tempfile::tempdir().unwrap();
     let bag = dir.path().join("no_imu.mcap");
-    copy_fixture(
-        &bag,
-        BagWriteOptions::default(),
-        |_| {},
-        |topic, _| {
-            if topic == "/imu" {
-                Copy::Drop
-            } else {
-                Copy::Keep
-            }
-        },
-    );
+    copy_fixture_imu_as(&bag, || Copy::Drop);
     let error = replay_bag(&bag).unwrap_err();
     let text = error.to_string();
     assert!(matches!(error, ReplayError::NoImu { .. }), "{text}");
@@ -293,18 +299,7 @@ fn a_bag_without_imu_fails_with_a_clear_message_and_a_non_zero_exit() {
 fn a_bag_whose_imu_never_decodes_exits_non_zero_and_says_what_was_used() {
     let dir = tempfile::tempdir().unwrap();
     let bag = dir.path().join("bad_imu.mcap");
-    copy_fixture(
-        &bag,
-        BagWriteOptions::default(),
-        |_| {},
-        |topic, _| {
-            if topic == "/imu" {
-                Copy::Replace(vec![0, 1, 0, 0, 7])
-            } else {
-                Copy::Keep
-            }
-        },
-    );
+    copy_fixture_imu_as(&bag, || Copy::Replace(vec![0, 1, 0, 0, 7]));
     let result = replay_bag(&bag).unwrap();
     assert_eq!(result.report.solutions, 0);
     assert_eq!(result.problems.used("/imu"), 0);

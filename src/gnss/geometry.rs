@@ -514,43 +514,29 @@ mod tests {
             alpha: [1e-8, 0.0, 0.0, 0.0],
             beta: [1e5, 0.0, 0.0, 0.0],
         };
-        let q = predict(
-            &obs,
-            &r_rx,
-            &Vector3::zeros(),
-            1234.0,
-            -5.0,
-            Some(&k),
-            1000.0,
-        )
-        .unwrap();
+        // The receiver state of `p`, with the Klobuchar model given.
+        let predict_klobuchar = |obs: &SatObservation| {
+            predict(
+                obs,
+                &r_rx,
+                &Vector3::zeros(),
+                1234.0,
+                -5.0,
+                Some(&k),
+                1000.0,
+            )
+            .unwrap()
+        };
+        let q = predict_klobuchar(&obs);
         assert_eq!((q.iono_m, q.tropo_m), (3.5, 2.0));
         obs.iono_delay_m = None;
-        let q = predict(
-            &obs,
-            &r_rx,
-            &Vector3::zeros(),
-            1234.0,
-            -5.0,
-            Some(&k),
-            1000.0,
-        )
-        .unwrap();
+        let q = predict_klobuchar(&obs);
         let expected_iono = klobuchar_delay_m(&k, &rx, q.azimuth_rad, q.elevation_rad, 1000.0);
         assert_eq!(q.iono_m, expected_iono);
         assert!(q.iono_m > 0.0);
         // Another troposphere model changes the delay and nothing else.
         obs.tropo_delay_m = None;
-        let q = predict(
-            &obs,
-            &r_rx,
-            &Vector3::zeros(),
-            1234.0,
-            -5.0,
-            Some(&k),
-            1000.0,
-        )
-        .unwrap();
+        let q = predict_klobuchar(&obs);
         assert_eq!(q.tropo_m, saastamoinen_delay_m(&rx, q.elevation_rad));
         for troposphere in [
             TroposphereModel::Off,
