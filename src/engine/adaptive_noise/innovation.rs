@@ -12,7 +12,7 @@ use crate::adaptive::innovation::{
 use crate::config::Config;
 use crate::gnss::SatId;
 
-use super::{NoiseVerdict, Observable, ScalarMeasurement, VarianceBounds};
+use super::{track_for, NoiseVerdict, Observable, ScalarMeasurement, VarianceBounds};
 
 #[derive(Debug, Clone)]
 struct Track {
@@ -48,31 +48,19 @@ impl InnovationNoise {
         }
     }
 
-    pub fn variances(
-        &mut self,
-        t_s: f64,
-        rows: &[ScalarMeasurement],
-        learn: bool,
-    ) -> Vec<NoiseVerdict> {
-        rows.iter()
-            .map(|row| self.variance(t_s, row, learn))
-            .collect()
-    }
-
-    fn variance(&mut self, t_s: f64, row: &ScalarMeasurement, learn: bool) -> NoiseVerdict {
+    /// The variance of one measurement at `t_s`; with `learn` false (re-applied after a
+    /// roll-back) the estimator is only read.
+    pub fn variance(&mut self, t_s: f64, row: &ScalarMeasurement, learn: bool) -> NoiseVerdict {
         let (r_min, r_max) = self.bounds.of(row.observable);
-        let track = match self.tracks.entry((row.sat, row.observable)) {
-            std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
-            std::collections::hash_map::Entry::Vacant(e) => {
-                let Ok(estimator) = InnovationCovarianceEstimator::new(self.options.clone()) else {
-                    return NoiseVerdict::nominal(row.r_nominal);
-                };
-                e.insert(Track {
-                    estimator,
-                    last_t_s: f64::NEG_INFINITY,
-                    last_verdict: None,
-                })
-            }
+        let new_track = || {
+            InnovationCovarianceEstimator::new(self.options.clone()).map(|estimator| Track {
+                estimator,
+                last_t_s: f64::NEG_INFINITY,
+                last_verdict: None,
+            })
+        };
+        let Some(track) = track_for(&mut self.tracks, row, new_track) else {
+            return NoiseVerdict::nominal(row.r_nominal);
         };
         if !learn || t_s <= track.last_t_s {
             return track

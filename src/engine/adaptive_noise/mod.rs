@@ -7,6 +7,9 @@ mod innovation;
 mod redundant;
 mod residual;
 
+use std::collections::hash_map::Entry;
+use std::collections::HashMap;
+
 use nalgebra::{DMatrix, DVector};
 
 use crate::config::{Config, FilterVariant};
@@ -100,15 +103,14 @@ impl NoiseModel {
         rows: &[ScalarMeasurement],
         learn: bool,
     ) -> Vec<NoiseVerdict> {
-        match self {
-            Self::Fixed => rows
-                .iter()
-                .map(|r| NoiseVerdict::nominal(r.r_nominal))
-                .collect(),
-            Self::Innovation(m) => m.variances(t_s, rows, learn),
-            Self::Redundant(m) => m.variances(t_s, rows, learn),
-            Self::Residual(m) => m.variances(rows),
-        }
+        rows.iter()
+            .map(|row| match self {
+                Self::Fixed => NoiseVerdict::nominal(row.r_nominal),
+                Self::Innovation(m) => m.variance(t_s, row, learn),
+                Self::Redundant(m) => m.variance(t_s, row, learn),
+                Self::Residual(m) => m.variance(row),
+            })
+            .collect()
     }
 
     /// True when the strategy needs the predictions of the corrected state.
@@ -195,6 +197,21 @@ impl VarianceBounds {
             Observable::Pseudorange => self.pseudorange_m2,
             Observable::PseudorangeRate => self.rate_m2_s2,
         }
+    }
+}
+
+/// The track of `row`'s satellite and observable in `tracks`, made by `new_track` when it
+/// is first seen. None when `new_track` fails: the estimator options were validated with
+/// the configuration, so that would be a programming error, and the caller falls back to
+/// the nominal variance (or learns nothing).
+pub(crate) fn track_for<'a, T, E>(
+    tracks: &'a mut HashMap<(SatId, Observable), T>,
+    row: &ScalarMeasurement,
+    new_track: impl FnOnce() -> Result<T, E>,
+) -> Option<&'a mut T> {
+    match tracks.entry((row.sat, row.observable)) {
+        Entry::Occupied(e) => Some(e.into_mut()),
+        Entry::Vacant(e) => new_track().ok().map(|track| e.insert(track)),
     }
 }
 

@@ -24,7 +24,9 @@ use crate::adaptive::redundant::{
 use crate::config::Config;
 use crate::gnss::SatId;
 
-use super::{estimator_seed, NoiseVerdict, Observable, ScalarMeasurement, VarianceBounds};
+use super::{
+    estimator_seed, track_for, NoiseVerdict, Observable, ScalarMeasurement, VarianceBounds,
+};
 
 /// What is remembered of a satellite's previous epoch.
 #[derive(Debug, Clone, Copy)]
@@ -75,38 +77,24 @@ impl RedundantNoise {
         }
     }
 
-    pub fn variances(
-        &mut self,
-        t_s: f64,
-        rows: &[ScalarMeasurement],
-        learn: bool,
-    ) -> Vec<NoiseVerdict> {
-        rows.iter()
-            .map(|row| self.variance(t_s, row, learn))
-            .collect()
-    }
-
-    fn variance(&mut self, t_s: f64, row: &ScalarMeasurement, learn: bool) -> NoiseVerdict {
+    /// The variance of one measurement at `t_s`; with `learn` false (re-applied after a
+    /// roll-back) the estimator is only read.
+    pub fn variance(&mut self, t_s: f64, row: &ScalarMeasurement, learn: bool) -> NoiseVerdict {
         let (r_min, r_max) = self.bounds.of(row.observable);
         let options = RedundantNoiseOptions {
             seed: estimator_seed(self.options.seed, row.sat, row.observable),
             ..self.options.clone()
         };
         let max_gap_s = self.max_gap_s;
-        let track = match self.tracks.entry((row.sat, row.observable)) {
-            std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
-            std::collections::hash_map::Entry::Vacant(e) => {
-                // The options were validated with the configuration; a failure here would
-                // be a programming error, so fall back to the nominal variance.
-                let Ok(estimator) = RedundantNoiseEstimator::new(options) else {
-                    return NoiseVerdict::nominal(row.r_nominal);
-                };
-                e.insert(Track {
-                    estimator,
-                    previous: None,
-                    last_verdict: None,
-                })
-            }
+        let new_track = || {
+            RedundantNoiseEstimator::new(options).map(|estimator| Track {
+                estimator,
+                previous: None,
+                last_verdict: None,
+            })
+        };
+        let Some(track) = track_for(&mut self.tracks, row, new_track) else {
+            return NoiseVerdict::nominal(row.r_nominal);
         };
         let fresh = track.previous.is_some_and(|p| t_s > p.t_s);
         if !learn || !fresh {

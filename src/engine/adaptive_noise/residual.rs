@@ -24,7 +24,7 @@ use crate::adaptive::residual_r::{ResidualCovarianceEstimator, ResidualCovarianc
 use crate::config::Config;
 use crate::gnss::SatId;
 
-use super::{NoiseVerdict, Observable, ScalarMeasurement, VarianceBounds};
+use super::{track_for, NoiseVerdict, Observable, ScalarMeasurement, VarianceBounds};
 
 #[derive(Debug, Clone)]
 struct Track {
@@ -58,26 +58,22 @@ impl ResidualNoise {
         }
     }
 
-    /// The variance of each scalar measurement: the window's estimate when full, else the
+    /// The variance of a scalar measurement: the window's estimate when full, else the
     /// nominal one.
-    pub fn variances(&self, rows: &[ScalarMeasurement]) -> Vec<NoiseVerdict> {
-        rows.iter()
-            .map(|row| {
-                let (lo, hi) = self.bounds.of(row.observable);
-                match self
-                    .tracks
-                    .get(&(row.sat, row.observable))
-                    .and_then(|t| t.estimator.estimate())
-                {
-                    Some(r) => NoiseVerdict {
-                        r: r[(0, 0)].clamp(lo, hi),
-                        estimated: true,
-                        ..NoiseVerdict::nominal(row.r_nominal)
-                    },
-                    None => NoiseVerdict::nominal(row.r_nominal),
-                }
-            })
-            .collect()
+    pub fn variance(&self, row: &ScalarMeasurement) -> NoiseVerdict {
+        let (lo, hi) = self.bounds.of(row.observable);
+        match self
+            .tracks
+            .get(&(row.sat, row.observable))
+            .and_then(|t| t.estimator.estimate())
+        {
+            Some(r) => NoiseVerdict {
+                r: r[(0, 0)].clamp(lo, hi),
+                estimated: true,
+                ..NoiseVerdict::nominal(row.r_nominal)
+            },
+            None => NoiseVerdict::nominal(row.r_nominal),
+        }
     }
 
     /// Learns from the measurements of an update at `t_s`: `posterior[i]` is the prediction
@@ -96,17 +92,14 @@ impl ResidualNoise {
                 continue;
             }
             let options = self.options;
-            let track = match self.tracks.entry((row.sat, row.observable)) {
-                std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
-                std::collections::hash_map::Entry::Vacant(e) => {
-                    let Ok(estimator) = ResidualCovarianceEstimator::new(options) else {
-                        continue;
-                    };
-                    e.insert(Track {
-                        estimator,
-                        last_t_s: f64::NEG_INFINITY,
-                    })
-                }
+            let new_track = || {
+                ResidualCovarianceEstimator::new(options).map(|estimator| Track {
+                    estimator,
+                    last_t_s: f64::NEG_INFINITY,
+                })
+            };
+            let Some(track) = track_for(&mut self.tracks, row, new_track) else {
+                continue;
             };
             learn(track, t_s, self.max_gap_s, |e| {
                 e.push(
@@ -189,13 +182,13 @@ mod tests {
         };
         for k in 0..4 {
             noise.after_update(f64::from(k), &[row], &[8.0], &[0.5]);
-            assert!(!noise.variances(&[row])[0].estimated);
+            assert!(!noise.variance(&row).estimated);
         }
         // The same epoch again (a roll-back) does not count.
         noise.after_update(3.0, &[row], &[8.0], &[0.5]);
-        assert!(!noise.variances(&[row])[0].estimated);
+        assert!(!noise.variance(&row).estimated);
         noise.after_update(4.0, &[row], &[8.0], &[0.5]);
-        let v = noise.variances(&[row])[0];
+        let v = noise.variance(&row);
         // ε = 2: ε² + hPh = 4.5.
         assert!(v.estimated);
         assert!((v.r - 4.5).abs() < 1e-12);
