@@ -38,62 +38,90 @@ impl ComparisonRow {
     }
 }
 
+/// A numeric column of [`ComparisonRow`]: its CSV name, and its table header, width and
+/// decimals.
+struct Column {
+    csv: &'static str,
+    header: &'static str,
+    width: usize,
+    decimals: usize,
+}
+
+const fn column(csv: &'static str, header: &'static str, width: usize, decimals: usize) -> Column {
+    Column {
+        csv,
+        header,
+        width,
+        decimals,
+    }
+}
+
+/// The numeric columns after the filter name, in the order of [`ComparisonRow::values`].
+const COLUMNS: [Column; 10] = [
+    column("pos_rmse_3d_m", "pos3d_m", 8, 3),
+    column("pos_rmse_e_m", "E_m", 7, 3),
+    column("pos_rmse_n_m", "N_m", 7, 3),
+    column("pos_rmse_u_m", "U_m", 7, 3),
+    column("vel_rmse_3d_mps", "vel_mps", 9, 4),
+    column("att_rmse_roll_deg", "roll_deg", 8, 4),
+    column("att_rmse_pitch_deg", "pitch_dg", 8, 4),
+    column("att_rmse_yaw_deg", "yaw_deg", 8, 4),
+    column("nees_mean", "NEES", 8, 2),
+    column("runtime_s", "time_s", 8, 3),
+];
+
+/// Width of the table's filter column.
+const FILTER_WIDTH: usize = 14;
+
+impl ComparisonRow {
+    /// The row's numbers in the order of [`COLUMNS`].
+    fn values(&self) -> [f64; 10] {
+        [
+            self.pos_rmse_3d_m,
+            self.pos_rmse_e_m,
+            self.pos_rmse_n_m,
+            self.pos_rmse_u_m,
+            self.vel_rmse_3d_mps,
+            self.att_rmse_roll_deg,
+            self.att_rmse_pitch_deg,
+            self.att_rmse_yaw_deg,
+            self.nees_mean,
+            self.runtime_s,
+        ]
+    }
+}
+
 /// The comparison as an aligned text table.
 pub fn format_table(rows: &[ComparisonRow]) -> String {
-    let mut out = format!(
-        "{:<14} {:>8} {:>7} {:>7} {:>7} {:>9} {:>8} {:>8} {:>8} {:>8} {:>8}\n",
-        "filter",
-        "pos3d_m",
-        "E_m",
-        "N_m",
-        "U_m",
-        "vel_mps",
-        "roll_deg",
-        "pitch_dg",
-        "yaw_deg",
-        "NEES",
-        "time_s"
-    );
+    let mut out = format!("{:<FILTER_WIDTH$}", "filter");
+    for c in &COLUMNS {
+        out.push_str(&format!(" {:>w$}", c.header, w = c.width));
+    }
+    out.push('\n');
     for r in rows {
-        out.push_str(&format!(
-            "{:<14} {:>8.3} {:>7.3} {:>7.3} {:>7.3} {:>9.4} {:>8.4} {:>8.4} {:>8.4} {:>8.2} {:>8.3}\n",
-            r.filter,
-            r.pos_rmse_3d_m,
-            r.pos_rmse_e_m,
-            r.pos_rmse_n_m,
-            r.pos_rmse_u_m,
-            r.vel_rmse_3d_mps,
-            r.att_rmse_roll_deg,
-            r.att_rmse_pitch_deg,
-            r.att_rmse_yaw_deg,
-            r.nees_mean,
-            r.runtime_s
-        ));
+        out.push_str(&format!("{:<FILTER_WIDTH$}", r.filter));
+        for (c, value) in COLUMNS.iter().zip(r.values()) {
+            out.push_str(&format!(" {value:>w$.d$}", w = c.width, d = c.decimals));
+        }
+        out.push('\n');
     }
     out
 }
 
 /// The comparison as CSV with a header line.
 pub fn format_csv(rows: &[ComparisonRow]) -> String {
-    let mut out = String::from(
-        "filter,pos_rmse_3d_m,pos_rmse_e_m,pos_rmse_n_m,pos_rmse_u_m,vel_rmse_3d_mps,\
-         att_rmse_roll_deg,att_rmse_pitch_deg,att_rmse_yaw_deg,nees_mean,runtime_s\n",
-    );
+    let mut out = String::from("filter");
+    for c in &COLUMNS {
+        out.push(',');
+        out.push_str(c.csv);
+    }
+    out.push('\n');
     for r in rows {
-        out.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{}\n",
-            r.filter,
-            r.pos_rmse_3d_m,
-            r.pos_rmse_e_m,
-            r.pos_rmse_n_m,
-            r.pos_rmse_u_m,
-            r.vel_rmse_3d_mps,
-            r.att_rmse_roll_deg,
-            r.att_rmse_pitch_deg,
-            r.att_rmse_yaw_deg,
-            r.nees_mean,
-            r.runtime_s
-        ));
+        out.push_str(&r.filter);
+        for value in r.values() {
+            out.push_str(&format!(",{value}"));
+        }
+        out.push('\n');
     }
     out
 }
@@ -151,4 +179,50 @@ pub fn format_environment_table(rows: &[EnvironmentRow]) -> String {
         ));
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row() -> ComparisonRow {
+        ComparisonRow {
+            filter: "ermakf".to_owned(),
+            pos_rmse_3d_m: 1.25,
+            pos_rmse_e_m: 0.5,
+            pos_rmse_n_m: 0.75,
+            pos_rmse_u_m: 0.875,
+            vel_rmse_3d_mps: 0.0625,
+            att_rmse_roll_deg: 0.03125,
+            att_rmse_pitch_deg: 0.015625,
+            att_rmse_yaw_deg: 0.5625,
+            nees_mean: 2.5,
+            runtime_s: 3.375,
+        }
+    }
+
+    #[test]
+    fn csv_names_every_field_and_writes_it_exactly() {
+        let text = format_csv(&[row()]);
+        let lines: Vec<Vec<&str>> = text.lines().map(|l| l.split(',').collect()).collect();
+        assert_eq!(lines.len(), 2);
+        let (header, values) = (&lines[0], &lines[1]);
+        assert_eq!(header[..2], ["filter", "pos_rmse_3d_m"]);
+        assert_eq!(header.last(), Some(&"runtime_s"));
+        assert_eq!(values[0], "ermakf");
+        let numbers: Vec<f64> = values[1..].iter().map(|v| v.parse().unwrap()).collect();
+        assert_eq!(numbers, row().values());
+        assert_eq!(numbers[8], 2.5, "nees_mean under its own name");
+        assert_eq!(header[9], "nees_mean");
+    }
+
+    #[test]
+    fn table_rows_line_up_with_the_header() {
+        let text = format_table(&[row(), row()]);
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), 3);
+        assert!(lines.iter().all(|l| l.len() == lines[0].len()), "{text}");
+        assert!(lines[1].starts_with("ermakf "));
+        assert!(lines[1].ends_with("    2.50    3.375"), "{text}");
+    }
 }
