@@ -6,14 +6,8 @@
 
 use nalgebra::{UnitQuaternion, Vector3};
 
-use super::raw::{
-    RawAdaptive, RawClock, RawConfig, RawEngine, RawFilter, RawGnss, RawImu, RawInit, RawLoose,
-    RawMounting, RawOutput, RawRobust,
-};
-use super::{
-    AdaptiveConfig, ClockConfig, Config, EngineConfig, FilterConfig, GnssConfig, ImuConfig,
-    InitConfig, LooseConfig, MountingConfig, OutputConfig, RobustConfig,
-};
+use super::raw::{RawClock, RawConfig, RawGnss, RawImu, RawInit, RawMounting, RawOutput};
+use super::{ClockConfig, Config, GnssConfig, ImuConfig, InitConfig, MountingConfig, OutputConfig};
 use crate::earth::Llh;
 
 /// Standard gravity (m/s²) defining the unit g (and µg) of accelerometer data sheets.
@@ -86,13 +80,7 @@ impl From<&RawConfig> for Config {
             output,
         } = raw;
         Config {
-            filter: FilterConfig {
-                variant: filter.variant,
-                coupling: filter.coupling,
-                joseph_form: filter.joseph_form,
-                base: filter.base,
-                q_scaling: filter.q_scaling,
-            },
+            filter: filter.clone(),
             imu: ImuConfig {
                 gyro_arw_rad_per_sqrt_s: imu.gyro_arw_deg_per_sqrt_h
                     * RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H,
@@ -124,49 +112,9 @@ impl From<&RawConfig> for Config {
                 constellations: gnss.constellations.iter().map(|&c| c.into()).collect(),
                 max_clock_jump_m: gnss.clock_jump_threshold_m,
             },
-            loose: LooseConfig {
-                use_fix_covariance: loose.use_fix_covariance,
-                fix_sigma_horizontal_m: loose.fix_sigma_horizontal_m,
-                fix_sigma_vertical_m: loose.fix_sigma_vertical_m,
-                velocity_sigma_mps: loose.velocity_sigma_mps,
-            },
-            adaptive: AdaptiveConfig {
-                window_size_m: adaptive.window_size_m,
-                min_samples: adaptive.min_samples,
-                random_weighting: adaptive.random_weighting,
-                random_seed: adaptive.random_seed,
-                kde_threshold: adaptive.kde_threshold,
-                kde_consecutive_epochs: adaptive.kde_consecutive_epochs,
-                ar_max_order: adaptive.ar_max_order,
-                ar_order_criterion: adaptive.ar_order_criterion,
-                ar_denominator_floor: adaptive.ar_denominator_floor,
-                innovation_window: adaptive.innovation_window,
-                innovation_significance: adaptive.innovation_significance,
-                pseudorange_sigma_min_m: adaptive.pseudorange_sigma_min_m,
-                pseudorange_sigma_max_m: adaptive.pseudorange_sigma_max_m,
-                pseudorange_rate_sigma_min_mps: adaptive.pseudorange_rate_sigma_min_mps,
-                pseudorange_rate_sigma_max_mps: adaptive.pseudorange_rate_sigma_max_mps,
-                max_epoch_gap_s: adaptive.max_epoch_gap_s,
-            },
-            robust: RobustConfig {
-                adaptive_factor_function: robust.adaptive_factor_function,
-                adaptive_factor_c: robust.adaptive_factor_c,
-                adaptive_factor_c0: robust.adaptive_factor_c0,
-                adaptive_factor_c1: robust.adaptive_factor_c1,
-                alpha_floor: robust.alpha_floor,
-                equivalent_weight_function: robust.equivalent_weight_function,
-                double_factor_c: robust.double_factor_c,
-                igg3_k0: robust.igg3_k0,
-                igg3_k1: robust.igg3_k1,
-                max_variance_inflation: robust.max_variance_inflation,
-                chi2_confidence: robust.chi2_confidence,
-                residual_window_epochs: robust.residual_window_epochs,
-                q_window_epochs: robust.q_window_epochs,
-                q_alpha_min: robust.q_alpha_min,
-                q_alpha_max: robust.q_alpha_max,
-                q_scale_min: robust.q_scale_min,
-                q_scale_max: robust.q_scale_max,
-            },
+            loose: loose.clone(),
+            adaptive: adaptive.clone(),
+            robust: robust.clone(),
             init: InitConfig {
                 heading_rad: init.heading_deg.map(|deg| deg * RAD_PER_DEG),
                 heading_min_speed_mps: init.heading_min_speed_mps,
@@ -179,10 +127,7 @@ impl From<&RawConfig> for Config {
                 clock_bias_sigma_m: init.clock_bias_sigma_m,
                 clock_drift_sigma_mps: init.clock_drift_sigma_mps,
             },
-            engine: EngineConfig {
-                imu_buffer_s: engine.imu_buffer_s,
-                max_imu_gap_s: engine.max_imu_gap_s,
-            },
+            engine: engine.clone(),
             output: OutputConfig {
                 datum: output.datum_llh_deg_m.map(|[lat_deg, lon_deg, height_m]| {
                     Llh::new(lat_deg * RAD_PER_DEG, lon_deg * RAD_PER_DEG, height_m)
@@ -211,13 +156,7 @@ impl From<&Config> for RawConfig {
         } = config;
         let deg = |rad: f64| si_to_human(rad, RAD_PER_DEG);
         RawConfig {
-            filter: RawFilter {
-                variant: filter.variant,
-                coupling: filter.coupling,
-                joseph_form: filter.joseph_form,
-                base: filter.base,
-                q_scaling: filter.q_scaling,
-            },
+            filter: filter.clone(),
             imu: RawImu {
                 gyro_arw_deg_per_sqrt_h: si_to_human(
                     imu.gyro_arw_rad_per_sqrt_s,
@@ -254,49 +193,9 @@ impl From<&Config> for RawConfig {
                 constellations: gnss.constellations.iter().map(|&c| c.into()).collect(),
                 clock_jump_threshold_m: gnss.max_clock_jump_m,
             },
-            loose: RawLoose {
-                use_fix_covariance: loose.use_fix_covariance,
-                fix_sigma_horizontal_m: loose.fix_sigma_horizontal_m,
-                fix_sigma_vertical_m: loose.fix_sigma_vertical_m,
-                velocity_sigma_mps: loose.velocity_sigma_mps,
-            },
-            adaptive: RawAdaptive {
-                window_size_m: adaptive.window_size_m,
-                min_samples: adaptive.min_samples,
-                random_weighting: adaptive.random_weighting,
-                random_seed: adaptive.random_seed,
-                kde_threshold: adaptive.kde_threshold,
-                kde_consecutive_epochs: adaptive.kde_consecutive_epochs,
-                ar_max_order: adaptive.ar_max_order,
-                ar_order_criterion: adaptive.ar_order_criterion,
-                ar_denominator_floor: adaptive.ar_denominator_floor,
-                innovation_window: adaptive.innovation_window,
-                innovation_significance: adaptive.innovation_significance,
-                pseudorange_sigma_min_m: adaptive.pseudorange_sigma_min_m,
-                pseudorange_sigma_max_m: adaptive.pseudorange_sigma_max_m,
-                pseudorange_rate_sigma_min_mps: adaptive.pseudorange_rate_sigma_min_mps,
-                pseudorange_rate_sigma_max_mps: adaptive.pseudorange_rate_sigma_max_mps,
-                max_epoch_gap_s: adaptive.max_epoch_gap_s,
-            },
-            robust: RawRobust {
-                adaptive_factor_function: robust.adaptive_factor_function,
-                adaptive_factor_c: robust.adaptive_factor_c,
-                adaptive_factor_c0: robust.adaptive_factor_c0,
-                adaptive_factor_c1: robust.adaptive_factor_c1,
-                alpha_floor: robust.alpha_floor,
-                equivalent_weight_function: robust.equivalent_weight_function,
-                double_factor_c: robust.double_factor_c,
-                igg3_k0: robust.igg3_k0,
-                igg3_k1: robust.igg3_k1,
-                max_variance_inflation: robust.max_variance_inflation,
-                chi2_confidence: robust.chi2_confidence,
-                residual_window_epochs: robust.residual_window_epochs,
-                q_window_epochs: robust.q_window_epochs,
-                q_alpha_min: robust.q_alpha_min,
-                q_alpha_max: robust.q_alpha_max,
-                q_scale_min: robust.q_scale_min,
-                q_scale_max: robust.q_scale_max,
-            },
+            loose: loose.clone(),
+            adaptive: adaptive.clone(),
+            robust: robust.clone(),
             init: RawInit {
                 heading_deg: init.heading_rad.map(deg),
                 heading_min_speed_mps: init.heading_min_speed_mps,
@@ -309,10 +208,7 @@ impl From<&Config> for RawConfig {
                 clock_bias_sigma_m: init.clock_bias_sigma_m,
                 clock_drift_sigma_mps: init.clock_drift_sigma_mps,
             },
-            engine: RawEngine {
-                imu_buffer_s: engine.imu_buffer_s,
-                max_imu_gap_s: engine.max_imu_gap_s,
-            },
+            engine: engine.clone(),
             output: RawOutput {
                 datum_llh_deg_m: output
                     .datum

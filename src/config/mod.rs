@@ -29,8 +29,7 @@ pub use convert::{
 };
 pub use error::ConfigError;
 pub use raw::{
-    ConstellationName, RawAdaptive, RawClock, RawConfig, RawEngine, RawFilter, RawGnss, RawImu,
-    RawInit, RawLoose, RawMounting, RawOutput, RawRobust,
+    ConstellationName, RawClock, RawConfig, RawGnss, RawImu, RawInit, RawMounting, RawOutput,
 };
 pub use sections::{
     AdaptiveConfig, AdaptiveFactorKind, ClockConfig, Config, Coupling, EngineConfig,

@@ -1,11 +1,17 @@
 //! The configuration exactly as written in the parameter file: human units in the key names,
 //! every key optional (a missing key takes its documented default), unknown keys refused.
 //!
+//! Sections whose keys carry no unit to convert (`filter`, `loose`, `adaptive`, `robust`,
+//! `engine`) are read straight into their SI section types; the others have a raw type here.
+//!
 //! The defaults here are THE documented defaults: `params/ekf.yaml` is tested to equal them.
 
 use serde::Deserialize;
 
-use super::{AdaptiveFactorKind, Coupling, EquivalentWeightKind, FilterBase, FilterVariant};
+use super::{
+    AdaptiveConfig, AdaptiveFactorKind, Coupling, EngineConfig, EquivalentWeightKind, FilterBase,
+    FilterConfig, FilterVariant, LooseConfig, RobustConfig,
+};
 use crate::adaptive::burg::OrderCriterion;
 use crate::gnss::Constellation;
 
@@ -13,31 +19,21 @@ use crate::gnss::Constellation;
 #[derive(Debug, Clone, PartialEq, Default, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct RawConfig {
-    pub filter: RawFilter,
+    pub filter: FilterConfig,
     pub imu: RawImu,
     pub mounting: RawMounting,
     pub clock: RawClock,
     pub gnss: RawGnss,
-    pub loose: RawLoose,
-    pub adaptive: RawAdaptive,
-    pub robust: RawRobust,
+    pub loose: LooseConfig,
+    pub adaptive: AdaptiveConfig,
+    pub robust: RobustConfig,
     pub init: RawInit,
-    pub engine: RawEngine,
+    pub engine: EngineConfig,
     pub output: RawOutput,
 }
 
-/// `filter.*`: which filter runs.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct RawFilter {
-    pub variant: FilterVariant,
-    pub coupling: Coupling,
-    pub joseph_form: bool,
-    pub base: FilterBase,
-    pub q_scaling: bool,
-}
-
-impl Default for RawFilter {
+/// The documented defaults of `filter.*`.
+impl Default for FilterConfig {
     fn default() -> Self {
         Self {
             variant: FilterVariant::Ekf,
@@ -140,17 +136,8 @@ impl Default for RawGnss {
     }
 }
 
-/// `loose.*`: receiver fix weighting (loose coupling).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct RawLoose {
-    pub use_fix_covariance: bool,
-    pub fix_sigma_horizontal_m: f64,
-    pub fix_sigma_vertical_m: f64,
-    pub velocity_sigma_mps: f64,
-}
-
-impl Default for RawLoose {
+/// The documented defaults of `loose.*`.
+impl Default for LooseConfig {
     fn default() -> Self {
         Self {
             use_fix_covariance: true,
@@ -161,29 +148,8 @@ impl Default for RawLoose {
     }
 }
 
-/// `adaptive.*`: online measurement-noise estimation (ERMAKF family).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct RawAdaptive {
-    pub window_size_m: usize,
-    pub min_samples: usize,
-    pub random_weighting: bool,
-    pub random_seed: u64,
-    pub kde_threshold: f64,
-    pub kde_consecutive_epochs: usize,
-    pub ar_max_order: usize,
-    pub ar_order_criterion: OrderCriterion,
-    pub ar_denominator_floor: f64,
-    pub innovation_window: usize,
-    pub innovation_significance: f64,
-    pub pseudorange_sigma_min_m: f64,
-    pub pseudorange_sigma_max_m: f64,
-    pub pseudorange_rate_sigma_min_mps: f64,
-    pub pseudorange_rate_sigma_max_mps: f64,
-    pub max_epoch_gap_s: f64,
-}
-
-impl Default for RawAdaptive {
+/// The documented defaults of `adaptive.*`.
+impl Default for AdaptiveConfig {
     fn default() -> Self {
         Self {
             window_size_m: 100,
@@ -206,30 +172,8 @@ impl Default for RawAdaptive {
     }
 }
 
-/// `robust.*`: IARF-paper and Ding constants (see [`super::RobustConfig`]).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct RawRobust {
-    pub adaptive_factor_function: AdaptiveFactorKind,
-    pub adaptive_factor_c: f64,
-    pub adaptive_factor_c0: f64,
-    pub adaptive_factor_c1: f64,
-    pub alpha_floor: f64,
-    pub equivalent_weight_function: EquivalentWeightKind,
-    pub double_factor_c: f64,
-    pub igg3_k0: f64,
-    pub igg3_k1: f64,
-    pub max_variance_inflation: f64,
-    pub chi2_confidence: f64,
-    pub residual_window_epochs: usize,
-    pub q_window_epochs: usize,
-    pub q_alpha_min: f64,
-    pub q_alpha_max: f64,
-    pub q_scale_min: f64,
-    pub q_scale_max: f64,
-}
-
-impl Default for RawRobust {
+/// The documented defaults of `robust.*`.
+impl Default for RobustConfig {
     fn default() -> Self {
         Self {
             adaptive_factor_function: AdaptiveFactorKind::TwoSegment,
@@ -286,15 +230,8 @@ impl Default for RawInit {
     }
 }
 
-/// `engine.*`: buffering of the sensor streams.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct RawEngine {
-    pub imu_buffer_s: f64,
-    pub max_imu_gap_s: f64,
-}
-
-impl Default for RawEngine {
+/// The documented defaults of `engine.*`.
+impl Default for EngineConfig {
     fn default() -> Self {
         Self {
             imu_buffer_s: 2.0,

@@ -1,5 +1,8 @@
 //! The validated configuration in SI units and radians: what the engine reads. Each field
 //! names the parameter-file key it comes from and that key's default.
+//!
+//! The sections whose keys need no unit conversion (`filter`, `loose`, `adaptive`, `robust`,
+//! `engine`) are also what the file is read into, before validation (see `raw`).
 
 use nalgebra::{UnitQuaternion, Vector3};
 use serde::Deserialize;
@@ -183,7 +186,8 @@ impl Coupling {
 }
 
 /// `filter.*`.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct FilterConfig {
     /// `filter.variant` (default `ekf`).
     pub variant: FilterVariant,
@@ -286,7 +290,8 @@ pub struct GnssConfig {
 }
 
 /// `loose.*`: weighting of the receiver fix in loose coupling.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct LooseConfig {
     /// true = weight the fix by the covariance the receiver publishes with it; false = by
     /// the σ below. `loose.use_fix_covariance` (default `true`).
@@ -301,7 +306,8 @@ pub struct LooseConfig {
 
 /// `adaptive.*`: the online measurement-noise estimators of the ERMAKF family (used by the
 /// `eiakf`, `srmakf` and `ermakf` variants; ignored by `ekf`).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct AdaptiveConfig {
     /// Window M of the redundant-measurement estimator (epochs), `adaptive.window_size_m`
     /// (default `100`).
@@ -347,7 +353,8 @@ pub struct AdaptiveConfig {
 /// `robust.*`: the constants of the IARF-paper schemes (adaptive factor, robust equivalent
 /// covariance, Mahalanobis test) and of Ding's residual R and Q scaling. All are
 /// dimensionless unless a unit is named.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct RobustConfig {
     /// `robust.adaptive_factor_function` (default `two_segment`).
     pub adaptive_factor_function: AdaptiveFactorKind,
@@ -416,7 +423,8 @@ pub struct InitConfig {
 }
 
 /// `engine.*`.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct EngineConfig {
     /// How far back a late GNSS epoch may reach into the IMU history (s),
     /// `engine.imu_buffer_s` (default `2.0`).

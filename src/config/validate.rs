@@ -241,25 +241,18 @@ fn validate_robust(raw: &RawConfig, c: &Checker) -> Result<(), ConfigError> {
     let r = &raw.robust;
     c.positive("robust.adaptive_factor_c", r.adaptive_factor_c)?;
     c.positive("robust.adaptive_factor_c0", r.adaptive_factor_c0)?;
-    if !(r.adaptive_factor_c1.is_finite() && r.adaptive_factor_c1 > r.adaptive_factor_c0) {
-        return Err(c.invalid(
-            "robust.adaptive_factor_c1",
-            r.adaptive_factor_c1,
-            "must be finite and > robust.adaptive_factor_c0",
-        ));
-    }
+    c.above(
+        "robust.adaptive_factor_c1",
+        r.adaptive_factor_c1,
+        "robust.adaptive_factor_c0",
+        r.adaptive_factor_c0,
+    )?;
     if !(r.alpha_floor.is_finite() && r.alpha_floor > 0.0 && r.alpha_floor <= 1.0) {
         return Err(c.invalid("robust.alpha_floor", r.alpha_floor, "must lie in (0, 1]"));
     }
     c.positive("robust.double_factor_c", r.double_factor_c)?;
     c.positive("robust.igg3_k0", r.igg3_k0)?;
-    if !(r.igg3_k1.is_finite() && r.igg3_k1 > r.igg3_k0) {
-        return Err(c.invalid(
-            "robust.igg3_k1",
-            r.igg3_k1,
-            "must be finite and > robust.igg3_k0",
-        ));
-    }
+    c.above("robust.igg3_k1", r.igg3_k1, "robust.igg3_k0", r.igg3_k0)?;
     c.within(
         "robust.max_variance_inflation",
         r.max_variance_inflation,
@@ -346,6 +339,16 @@ impl Checker<'_> {
             Ok(())
         } else {
             Err(self.invalid(key, value, "must be finite and > 0"))
+        }
+    }
+
+    /// A finite value above `lower`, the value of the key `lower_key` (an upper threshold
+    /// above its lower one).
+    fn above(&self, key: &str, value: f64, lower_key: &str, lower: f64) -> Result<(), ConfigError> {
+        if value.is_finite() && value > lower {
+            Ok(())
+        } else {
+            Err(self.invalid(key, value, &format!("must be finite and > {lower_key}")))
         }
     }
 
