@@ -7,6 +7,8 @@
 //! DDS traffic stays on this machine: the test re-executes itself inside a private
 //! network namespace that has only loopback (`unshare -n`, needs root).
 
+mod netns_support;
+
 use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -18,12 +20,12 @@ use adaptive_gnss_ins::ros::msg::{Clock, GnssMeasurements, Imu, Odometry, RosMes
 use adaptive_gnss_ins::sim::{Scenario, ScenarioSpec};
 use adaptive_gnss_ins::tools::replay::{replay, ReplayOptions, ReplayResult, TruthSource};
 use adaptive_gnss_ins::tools::simulate::{simulate_with, SimulateOptions};
+use netns_support::reexec_in_private_netns;
 use ros2_client::{
     Context, ContextOptions, MessageTypeName, Name, Node, NodeName, NodeOptions, QosProfile,
     Subscription,
 };
 
-const IN_NETNS: &str = "GNSS_INS_PLAY_TEST_IN_NETNS";
 const DOMAIN_ID: u16 = 23;
 /// Playing speed: the 36 s fixture plays in 9 s.
 const RATE: f64 = 4.0;
@@ -33,25 +35,6 @@ const RATE: f64 = 4.0;
 /// player's history still holds it. A loaded CI machine once lost the first Imu message
 /// that way, so the player waits as a user of `ros2 bag play --delay` would.
 const PLAYER_DELAY_S: &str = "2";
-
-fn reexec_in_private_netns(name: &str) -> bool {
-    if std::env::var_os(IN_NETNS).is_some() {
-        return false;
-    }
-    let exe = std::env::current_exe().unwrap();
-    let status = Command::new("unshare")
-        .args(["-n", "sh", "-c", "ip link set lo up && exec \"$0\" \"$@\""])
-        .arg(exe)
-        .args([name, "--exact", "--nocapture", "--test-threads=1"])
-        .env(IN_NETNS, "1")
-        .status()
-        .expect("this test needs `unshare` (util-linux) and root");
-    assert!(
-        status.success(),
-        "{name} failed inside the network namespace"
-    );
-    true
-}
 
 fn fixture() -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/fixture_small.mcap")
