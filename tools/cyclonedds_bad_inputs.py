@@ -35,7 +35,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import cyclonedds_ros_types as ros  # noqa: E402
 from cyclonedds_peer import (  # noqa: E402
     Checks, Peer, paced, peer_argument_parser, read_bag, report, wait_until)
-from cyclonedds_setup import writer, xcdr1_qos  # noqa: E402
+import cyclonedds_setup as dds  # noqa: E402
 
 # Malformed messages sent of each kind, and the stream's bad-sample period.
 MALFORMED_EACH = 5
@@ -104,13 +104,13 @@ def main():
     inputs, _, _ = read_bag(args.bag)
     peer = Peer(args.namespace, args.node)
     ns = args.namespace.rstrip('/')
-    qos = xcdr1_qos(depth=1000)
+    qos = dds.xcdr1_qos(depth=1000)
     # The malformed types need their own participant: one participant has one type per
     # topic.
     liar = DomainParticipant(peer.participant.domain_id)
-    bad_imu = writer(liar, f'rt{ns}/imu', TruncatedImu, qos)
-    bad_gnss = writer(liar, f'rt{ns}/gnss/measurements', LyingGnss, qos)
-    bad_fix = writer(liar, f'rt{ns}/gnss/fix', ShortCovarianceFix, qos)
+    bad_imu = dds.writer(liar, f'rt{ns}/imu', TruncatedImu, qos)
+    bad_gnss = dds.writer(liar, f'rt{ns}/gnss/measurements', LyingGnss, qos)
+    bad_fix = dds.writer(liar, f'rt{ns}/gnss/fix', ShortCovarianceFix, qos)
     second_imu = DataWriter(peer.participant, peer.imu.topic, qos=qos)
     if not checks.that(wait_until(peer.matched, 30.0), 'the node was not discovered'):
         return report(summary, checks)
