@@ -14,7 +14,7 @@ mod support;
 use rand_chacha::rand_core::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use statrs::distribution::{ChiSquared, ContinuousCDF};
-use support::drive::drive;
+use support::drive::{drive, drive_epoch};
 
 /// Horizontal and vertical position RMSE budgets after convergence (m): with about nine
 /// satellites at 3 m zenith σ, single-epoch positions scatter by about 1.5 m horizontally
@@ -109,7 +109,6 @@ fn run_drive(config: Config) -> Metrics {
     let mut imu_errors = ImuErrorModel::new(&ImuErrorSpec::default(), imu_rate_hz, 42).unwrap();
     let constellation = GpsConstellation::augmented(1);
     let mut rng = ChaCha8Rng::seed_from_u64(7);
-    let (clock0_m, drift_mps) = (3_000.0, -25.0);
     let mut engine = Engine::new(config);
     let mut scored = Vec::new();
     let mut t_init = None;
@@ -118,13 +117,7 @@ fn run_drive(config: Config) -> Metrics {
         let measured = imu_errors.corrupt(&truth.imu);
         let mut outputs = engine.push_imu(&measured).unwrap();
         if (t - t.round()).abs() < 1e-9 {
-            let receiver = support::Receiver {
-                p: &truth.nav.p,
-                v_n: truth.nav.v_n,
-                clock_bias_m: clock0_m + drift_mps * t,
-                clock_drift_mps: drift_mps,
-            };
-            let epoch = support::noisy_epoch(&constellation, &mut rng, t, &receiver);
+            let epoch = drive_epoch(&constellation, &mut rng, &truth.nav);
             outputs.extend(engine.push_gnss(epoch).unwrap());
             // Score once per second, at the solution right after the update.
             if let Some(state) = engine.state() {

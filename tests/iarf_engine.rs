@@ -22,7 +22,7 @@ use nalgebra::Vector3;
 use rand_chacha::rand_core::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal, Uniform};
-use support::drive::drive;
+use support::drive::{drive, drive_epoch};
 
 /// Scoring starts this long after the start-up (s).
 const SETTLING_S: f64 = 60.0;
@@ -89,7 +89,6 @@ fn run(config: Config, laps: usize, feed: Feed) -> Run {
     let mut outlier_rng = ChaCha8Rng::seed_from_u64(11);
     let unit = Normal::new(0.0, 1.0).unwrap();
     let uniform = Uniform::new(0.0, 1.0).unwrap();
-    let (clock0_m, drift_mps) = (3_000.0, -25.0);
     let _ = env_logger::builder().is_test(true).try_init();
     let mut engine = Engine::new(config);
     let mut errors = Vec::new();
@@ -127,13 +126,7 @@ fn run(config: Config, laps: usize, feed: Feed) -> Run {
                     outputs.extend(engine.push_fix(fix).unwrap());
                 }
                 Feed::Ranges => {
-                    let receiver = support::Receiver {
-                        p: &truth.nav.p,
-                        v_n: truth.nav.v_n,
-                        clock_bias_m: clock0_m + drift_mps * t,
-                        clock_drift_mps: drift_mps,
-                    };
-                    let epoch = support::noisy_epoch(&constellation, &mut rng, t, &receiver);
+                    let epoch = drive_epoch(&constellation, &mut rng, &truth.nav);
                     outputs.extend(engine.push_gnss(epoch).unwrap());
                 }
             }

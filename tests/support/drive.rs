@@ -1,6 +1,30 @@
-//! The simulated vehicle drive shared by the engine tests.
+//! The simulated vehicle drive shared by the engine tests, and its GPS epochs.
 
+use adaptive_gnss_ins::gnss::GnssEpoch;
+use adaptive_gnss_ins::ins::NavState;
+use adaptive_gnss_ins::sim::constellation::GpsConstellation;
 use adaptive_gnss_ins::sim::{Segment, TrajectorySpec};
+use rand_chacha::ChaCha8Rng;
+
+/// The drive's receiver clock: its bias at the start (m) and its constant drift (m/s).
+const CLOCK_BIAS_AT_START_M: f64 = 3_000.0;
+const CLOCK_DRIFT_MPS: f64 = -25.0;
+
+/// The GPS epoch of the drive at the true state `nav`: the noisy ranges of
+/// [`super::noisy_epoch`] for a receiver with the drive's drifting clock.
+pub fn drive_epoch(
+    constellation: &GpsConstellation,
+    rng: &mut ChaCha8Rng,
+    nav: &NavState,
+) -> GnssEpoch {
+    let receiver = super::Receiver {
+        p: &nav.p,
+        v_n: nav.v_n,
+        clock_bias_m: CLOCK_BIAS_AT_START_M + CLOCK_DRIFT_MPS * nav.t_s,
+        clock_drift_mps: CLOCK_DRIFT_MPS,
+    };
+    super::noisy_epoch(constellation, rng, nav.t_s, &receiver)
+}
 
 /// A vehicle drive (accelerations, turns, a stop, a hill) after 10 s at rest, its moving
 /// part repeated `laps` times.
