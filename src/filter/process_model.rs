@@ -218,34 +218,60 @@ pub fn noise_density(noise: &ProcessNoise) -> StateVector {
     q
 }
 
-/// The non-zero entries of F (about 80 of 400), for cheap products with dense matrices.
-struct SparseRows {
-    entries: Vec<(usize, usize, f64)>,
+/// The non-zero entries of F (about 85 of 400), for cheap products with dense matrices:
+/// their column-major indices r + N·c in a fixed array (no allocation per IMU sample).
+struct SparseF<'a> {
+    f: &'a StateMatrix,
+    index: [u16; N * N],
+    len: usize,
 }
 
-impl SparseRows {
-    fn new(f: &StateMatrix) -> Self {
-        let mut entries = Vec::with_capacity(96);
-        for c in 0..N {
-            for r in 0..N {
-                let v = f[(r, c)];
-                if v != 0.0 {
-                    entries.push((r, c, v));
-                }
+impl<'a> SparseF<'a> {
+    fn new(f: &'a StateMatrix) -> Self {
+        let mut index = [0u16; N * N];
+        let mut len = 0;
+        for (i, v) in f.as_slice().iter().enumerate() {
+            if *v != 0.0 {
+                // N · N = 400 fits u16.
+                index[len] = i as u16;
+                len += 1;
             }
         }
-        Self { entries }
+        Self { f, index, len }
     }
 
-    /// The Lyapunov operator L(X) = F X + X Fᵀ of a symmetric X.
-    fn lyapunov(&self, x: &StateMatrix) -> StateMatrix {
-        let mut fx = StateMatrix::zeros();
-        for &(r, k, v) in &self.entries {
-            for c in 0..N {
-                fx[(r, c)] += v * x[(k, c)];
+    /// The Lyapunov operator L(X) = F X + X Fᵀ = F X + (F X)ᵀ of a symmetric X, given
+    /// `x_rows`, the matrix whose column k is row k of X (Xᵀ; X itself when X is exactly
+    /// symmetric). The result is exactly symmetric.
+    ///
+    /// Math note (rounding): row r of F X is accumulated as Σ_k F[r,k] X[k,·] over the
+    /// non-zero F[r,k] in increasing k, into a column of G = (F X)ᵀ so that the 20 sums of
+    /// a row run over contiguous memory; L[i,j] = G[j,i] + G[i,j] is computed once per
+    /// pair and mirrored (floating-point addition is commutative, so both triangles of
+    /// F X + (F X)ᵀ hold these same numbers).
+    fn lyapunov(&self, x_rows: &StateMatrix) -> StateMatrix {
+        let f = self.f.as_slice();
+        let x = x_rows.as_slice();
+        let mut g = StateMatrix::zeros();
+        let gs = g.as_mut_slice();
+        for &i in &self.index[..self.len] {
+            let i = usize::from(i);
+            let (r, k, v) = (i % N, i / N, f[i]);
+            let x_row = &x[k * N..(k + 1) * N];
+            let g_col = &mut gs[r * N..(r + 1) * N];
+            for (gc, xc) in g_col.iter_mut().zip(x_row) {
+                *gc += v * xc;
             }
         }
-        fx + fx.transpose()
+        let mut l = StateMatrix::zeros();
+        for j in 0..N {
+            for i in 0..=j {
+                let s = g[(j, i)] + g[(i, j)];
+                l[(i, j)] = s;
+                l[(j, i)] = s;
+            }
+        }
+        l
     }
 }
 
@@ -268,12 +294,28 @@ pub fn propagate_covariance(
     p: &StateMatrix,
     dt_s: f64,
 ) -> StateMatrix {
-    let f_sparse = SparseRows::new(f);
-    let t1 = f_sparse.lyapunov(p) + StateMatrix::from_diagonal(q_c);
+    let f_sparse = SparseF::new(f);
+    // P is symmetric only up to rounding when it comes from outside: its rows are the
+    // columns of Pᵀ. T₁ and T₂ are exactly symmetric, so they are their own row matrices.
+    let mut t1 = f_sparse.lyapunov(&p.transpose());
+    for i in 0..N {
+        t1[(i, i)] += q_c[i];
+    }
     let t2 = f_sparse.lyapunov(&t1);
     let t3 = f_sparse.lyapunov(&t2);
-    let p_new = p + t1 * dt_s + t2 * (dt_s * dt_s * 0.5) + t3 * (dt_s.powi(3) / 6.0);
-    (p_new + p_new.transpose()) * 0.5
+    let (c1, c2, c3) = (dt_s, dt_s * dt_s * 0.5, dt_s.powi(3) / 6.0);
+    let p_new =
+        |i: usize, j: usize| p[(i, j)] + t1[(i, j)] * c1 + t2[(i, j)] * c2 + t3[(i, j)] * c3;
+    // (P_new + P_newᵀ)/2, one triangle computed and mirrored.
+    let mut out = StateMatrix::zeros();
+    for j in 0..N {
+        for i in 0..=j {
+            let v = (p_new(i, j) + p_new(j, i)) * 0.5;
+            out[(i, j)] = v;
+            out[(j, i)] = v;
+        }
+    }
+    out
 }
 
 #[cfg(test)]
@@ -356,6 +398,51 @@ mod tests {
         p[(CLOCK_BIAS, DP + 2)] = 0.5 * sigmas[CLOCK_BIAS] * sigmas[DP + 2];
         p[(DP + 2, CLOCK_BIAS)] = p[(CLOCK_BIAS, DP + 2)];
         p
+    }
+
+    /// The series of [`propagate_covariance`] written out plainly: (F X)[r,c] summed over
+    /// the non-zero F[r,k] in increasing k, whole-matrix sums and products.
+    fn plain_series(f: &StateMatrix, q: &StateVector, p: &StateMatrix, dt: f64) -> StateMatrix {
+        let lyapunov = |x: &StateMatrix| {
+            let mut fx = StateMatrix::zeros();
+            for r in 0..N {
+                for c in 0..N {
+                    let mut sum = 0.0;
+                    for k in (0..N).filter(|&k| f[(r, k)] != 0.0) {
+                        sum += f[(r, k)] * x[(k, c)];
+                    }
+                    fx[(r, c)] = sum;
+                }
+            }
+            fx + fx.transpose()
+        };
+        let t1 = lyapunov(p) + StateMatrix::from_diagonal(q);
+        let t2 = lyapunov(&t1);
+        let t3 = lyapunov(&t2);
+        let p_new = p + t1 * dt + t2 * (dt * dt * 0.5) + t3 * (dt.powi(3) / 6.0);
+        (p_new + p_new.transpose()) * 0.5
+    }
+
+    #[test]
+    fn propagation_gives_the_plain_series_bit_for_bit() {
+        let n = noise();
+        let f = system_matrix(&moving_point(), &n);
+        let q = noise_density(&n);
+        // A symmetric prior and one whose triangles differ in the last bits, as a caller's
+        // P may.
+        let mut lopsided = prior();
+        lopsided[(DV, PHI + 1)] *= 1.0 + 4.0 * f64::EPSILON;
+        lopsided[(CLOCK_BIAS, DP + 2)] *= 1.0 - 2.0 * f64::EPSILON;
+        assert_ne!(lopsided, lopsided.transpose());
+        for p0 in [prior(), lopsided] {
+            for dt in [0.005, 0.01, 0.02] {
+                let ours = propagate_covariance(&f, &q, &p0, dt);
+                let plain = plain_series(&f, &q, &p0, dt);
+                for (i, (a, b)) in ours.iter().zip(plain.iter()).enumerate() {
+                    assert_eq!(a.to_bits(), b.to_bits(), "dt {dt}: entry {i}: {a} vs {b}");
+                }
+            }
+        }
     }
 
     #[test]
