@@ -218,61 +218,67 @@ pub fn noise_density(noise: &ProcessNoise) -> StateVector {
     q
 }
 
-/// The non-zero entries of F (about 85 of 400), for cheap products with dense matrices:
-/// their column-major indices r + N·c in a fixed array (no allocation per IMU sample).
+/// The non-zero entries of F (about 85 of 400), row by row, for cheap products with dense
+/// matrices; fixed arrays, so nothing is allocated per IMU sample.
 struct SparseF<'a> {
     f: &'a StateMatrix,
-    index: [u16; N * N],
-    len: usize,
+    /// Column indices k of the non-zero F[r, k], row after row, in increasing k.
+    cols: [u8; N * N],
+    /// End of row r's entries in `cols`.
+    row_end: [u16; N],
 }
+
+/// Rows of a 20 × 20 matrix, row r at index r.
+type Rows = [[f64; N]; N];
 
 impl<'a> SparseF<'a> {
     fn new(f: &'a StateMatrix) -> Self {
-        let mut index = [0u16; N * N];
-        let mut len = 0;
-        for (i, v) in f.as_slice().iter().enumerate() {
-            if *v != 0.0 {
-                // N · N = 400 fits u16.
-                index[len] = i as u16;
-                len += 1;
+        let mut cols = [0u8; N * N];
+        let mut row_end = [0u16; N];
+        let mut len = 0usize;
+        for (r, end) in row_end.iter_mut().enumerate() {
+            for k in 0..N {
+                // Written always, kept when non-zero (no branch on the data); k < N = 20
+                // and len ≤ N · N = 400 fit their types.
+                cols[len] = k as u8;
+                len += usize::from(f[(r, k)] != 0.0);
             }
+            *end = len as u16;
         }
-        Self { f, index, len }
+        Self { f, cols, row_end }
     }
 
-    /// The Lyapunov operator L(X) = F X + X Fᵀ = F X + (F X)ᵀ of a symmetric X, given
-    /// `x_rows`, the matrix whose column k is row k of X (Xᵀ; X itself when X is exactly
-    /// symmetric). The result is exactly symmetric.
+    /// Writes the rows of F X into `fx`, given `x_rows`, the matrix whose column k is row k
+    /// of X (Xᵀ; X itself when X is exactly symmetric).
     ///
-    /// Math note (rounding): row r of F X is accumulated as Σ_k F[r,k] X[k,·] over the
-    /// non-zero F[r,k] in increasing k, into a column of G = (F X)ᵀ so that the 20 sums of
-    /// a row run over contiguous memory; L[i,j] = G[j,i] + G[i,j] is computed once per
-    /// pair and mirrored (floating-point addition is commutative, so both triangles of
-    /// F X + (F X)ᵀ hold these same numbers).
-    fn lyapunov(&self, x_rows: &StateMatrix) -> StateMatrix {
+    /// Math note (rounding): (F X)[r, c] is the sum of F[r, k] X[k, c] over the non-zero
+    /// F[r, k] in increasing k, starting from zero, as a plain row-times-column product
+    /// that skips F's zeros would add them; a row's 20 sums run side by side.
+    fn times(&self, x_rows: &StateMatrix, fx: &mut Rows) {
         let f = self.f.as_slice();
         let x = x_rows.as_slice();
-        let mut g = StateMatrix::zeros();
-        let gs = g.as_mut_slice();
-        for &i in &self.index[..self.len] {
-            let i = usize::from(i);
-            let (r, k, v) = (i % N, i / N, f[i]);
-            let x_row = &x[k * N..(k + 1) * N];
-            let g_col = &mut gs[r * N..(r + 1) * N];
-            for (gc, xc) in g_col.iter_mut().zip(x_row) {
-                *gc += v * xc;
+        let mut start = 0;
+        for (r, (row, &end)) in fx.iter_mut().zip(&self.row_end).enumerate() {
+            let end = usize::from(end);
+            let mut acc = [0.0; N];
+            for &k in &self.cols[start..end] {
+                let k = usize::from(k);
+                let v = f[r + N * k];
+                for (a, xc) in acc.iter_mut().zip(&x[k * N..(k + 1) * N]) {
+                    *a += v * xc;
+                }
             }
+            *row = acc;
+            start = end;
         }
-        let mut l = StateMatrix::zeros();
-        for j in 0..N {
-            for i in 0..=j {
-                let s = g[(j, i)] + g[(i, j)];
-                l[(i, j)] = s;
-                l[(j, i)] = s;
-            }
-        }
-        l
     }
+}
+
+/// The Lyapunov operator L(X) = F X + X Fᵀ = F X + (F X)ᵀ of a symmetric X, from the rows
+/// `fx` of F X. The result is exactly symmetric: L[i, j] and L[j, i] add the same two
+/// numbers, and floating-point addition is commutative.
+fn lyapunov(fx: &Rows, i: usize, j: usize) -> f64 {
+    fx[i][j] + fx[j][i]
 }
 
 /// Time update of the covariance over `dt_s`, eq. (10): P⁻ = Φ P Φᵀ + Q_d with Van Loan's
@@ -297,25 +303,24 @@ pub fn propagate_covariance(
     let f_sparse = SparseF::new(f);
     // P is symmetric only up to rounding when it comes from outside: its rows are the
     // columns of Pᵀ. T₁ and T₂ are exactly symmetric, so they are their own row matrices.
-    let mut t1 = f_sparse.lyapunov(&p.transpose());
-    for i in 0..N {
-        t1[(i, i)] += q_c[i];
-    }
-    let t2 = f_sparse.lyapunov(&t1);
-    let t3 = f_sparse.lyapunov(&t2);
-    let (c1, c2, c3) = (dt_s, dt_s * dt_s * 0.5, dt_s.powi(3) / 6.0);
-    let p_new =
-        |i: usize, j: usize| p[(i, j)] + t1[(i, j)] * c1 + t2[(i, j)] * c2 + t3[(i, j)] * c3;
-    // (P_new + P_newᵀ)/2, one triangle computed and mirrored.
-    let mut out = StateMatrix::zeros();
-    for j in 0..N {
-        for i in 0..=j {
-            let v = (p_new(i, j) + p_new(j, i)) * 0.5;
-            out[(i, j)] = v;
-            out[(j, i)] = v;
+    let mut fx: Rows = [[0.0; N]; N];
+    f_sparse.times(&p.transpose(), &mut fx);
+    let t1 = StateMatrix::from_fn(|i, j| {
+        let l = lyapunov(&fx, i, j);
+        if i == j {
+            l + q_c[i]
+        } else {
+            l
         }
-    }
-    out
+    });
+    f_sparse.times(&t1, &mut fx);
+    let t2 = StateMatrix::from_fn(|i, j| lyapunov(&fx, i, j));
+    f_sparse.times(&t2, &mut fx);
+    let (c1, c2, c3) = (dt_s, dt_s * dt_s * 0.5, dt_s.powi(3) / 6.0);
+    let p_new = StateMatrix::from_fn(|i, j| {
+        p[(i, j)] + t1[(i, j)] * c1 + t2[(i, j)] * c2 + lyapunov(&fx, i, j) * c3
+    });
+    StateMatrix::from_fn(|i, j| (p_new[(i, j)] + p_new[(j, i)]) * 0.5)
 }
 
 #[cfg(test)]
