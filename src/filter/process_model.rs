@@ -218,14 +218,12 @@ pub fn noise_density(noise: &ProcessNoise) -> StateVector {
     q
 }
 
-/// The non-zero entries of F (about 85 of 400), row by row, for cheap products with dense
-/// matrices; fixed arrays, so nothing is allocated per IMU sample.
+/// The non-zero pattern of F (about 85 of 400 entries), row by row, for cheap products with
+/// dense matrices; nothing is allocated per IMU sample.
 struct SparseF<'a> {
     f: &'a StateMatrix,
-    /// Column indices k of the non-zero F[r, k], row after row, in increasing k.
-    cols: [u8; N * N],
-    /// End of row r's entries in `cols`.
-    row_end: [u16; N],
+    /// Bit k of `rows[r]` is set when F[r, k] is not zero (N = 20 bits fit a u32).
+    rows: [u32; N],
 }
 
 /// Rows of a 20 × 20 matrix, row r at index r.
@@ -233,19 +231,10 @@ type Rows = [[f64; N]; N];
 
 impl<'a> SparseF<'a> {
     fn new(f: &'a StateMatrix) -> Self {
-        let mut cols = [0u8; N * N];
-        let mut row_end = [0u16; N];
-        let mut len = 0usize;
-        for (r, end) in row_end.iter_mut().enumerate() {
-            for k in 0..N {
-                // Written always, kept when non-zero (no branch on the data); k < N = 20
-                // and len ≤ N · N = 400 fit their types.
-                cols[len] = k as u8;
-                len += usize::from(f[(r, k)] != 0.0);
-            }
-            *end = len as u16;
-        }
-        Self { f, cols, row_end }
+        let rows = std::array::from_fn(|r| {
+            (0..N).fold(0u32, |mask, k| mask | (u32::from(f[(r, k)] != 0.0) << k))
+        });
+        Self { f, rows }
     }
 
     /// Writes the rows of F X into `fx`, given `x_rows`, the matrix whose column k is row k
@@ -257,19 +246,19 @@ impl<'a> SparseF<'a> {
     fn times(&self, x_rows: &StateMatrix, fx: &mut Rows) {
         let f = self.f.as_slice();
         let x = x_rows.as_slice();
-        let mut start = 0;
-        for (r, (row, &end)) in fx.iter_mut().zip(&self.row_end).enumerate() {
-            let end = usize::from(end);
+        for (r, (row, &pattern)) in fx.iter_mut().zip(&self.rows).enumerate() {
             let mut acc = [0.0; N];
-            for &k in &self.cols[start..end] {
-                let k = usize::from(k);
+            // The set bits from the lowest: k in increasing order.
+            let mut mask = pattern;
+            while mask != 0 {
+                let k = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
                 let v = f[r + N * k];
                 for (a, xc) in acc.iter_mut().zip(&x[k * N..(k + 1) * N]) {
                     *a += v * xc;
                 }
             }
             *row = acc;
-            start = end;
         }
     }
 }
