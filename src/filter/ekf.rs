@@ -86,7 +86,7 @@ pub fn update(
         .cholesky()
         .ok_or(FilterError::SingularInnovationCovariance { rows: m })?;
     // K = P Hᵀ S⁻¹  ⇔  S Kᵀ = H P.
-    let k = chol.solve(&pht.transpose()).transpose();
+    let k = kalman_gain(chol.l_dirty(), &pht);
     let dx_dyn = &k * y;
     let nis = y.dot(&chol.solve(y));
     let i_kh = DMatrix::<f64>::identity(N, N) - &k * h;
@@ -110,6 +110,50 @@ pub fn update(
         s,
         nis,
     })
+}
+
+/// The gain K = P Hᵀ S⁻¹ from the lower Cholesky factor `l` of S = L Lᵀ (only its lower
+/// triangle is read) and P Hᵀ (N × m): S Kᵀ = H P solved by forward substitution
+/// L Z = H P and back substitution Lᵀ Kᵀ = Z, for all N right-hand sides at once.
+///
+/// Math note (layout): row i of H P is column i of P Hᵀ and row i of Kᵀ is column i of K,
+/// both contiguous, so each step of either substitution updates N numbers side by side.
+/// The forward sums run in increasing j, as a column-by-column solve adds them; the back
+/// substitution sums Σ_{j>i} L[j, i] x_j in increasing j (a column-by-column solve may
+/// group that sum differently: the two agree to rounding).
+fn kalman_gain(l: &DMatrix<f64>, pht: &DMatrix<f64>) -> DMatrix<f64> {
+    let m = pht.ncols();
+    let mut k = pht.clone();
+    let ks = k.as_mut_slice();
+    for i in 0..m {
+        let mut acc = [0.0; N];
+        acc.copy_from_slice(&ks[i * N..(i + 1) * N]);
+        for j in 0..i {
+            let l_ij = l[(i, j)];
+            for (a, z) in acc.iter_mut().zip(&ks[j * N..(j + 1) * N]) {
+                *a -= l_ij * z;
+            }
+        }
+        let d = l[(i, i)];
+        for (out, a) in ks[i * N..(i + 1) * N].iter_mut().zip(&acc) {
+            *out = a / d;
+        }
+    }
+    for i in (0..m).rev() {
+        let mut acc = [0.0; N];
+        acc.copy_from_slice(&ks[i * N..(i + 1) * N]);
+        for j in i + 1..m {
+            let l_ji = l[(j, i)];
+            for (a, x) in acc.iter_mut().zip(&ks[j * N..(j + 1) * N]) {
+                *a -= l_ji * x;
+            }
+        }
+        let d = l[(i, i)];
+        for (out, a) in ks[i * N..(i + 1) * N].iter_mut().zip(&acc) {
+            *out = a / d;
+        }
+    }
+    k
 }
 
 /// K R Kᵀ, with R's columns applied as a scaling when R is diagonal (the usual case of
@@ -163,6 +207,25 @@ mod tests {
             let dense = &k * &r * k.transpose();
             assert!((k_r_kt(&k, &r) - dense).amax() < 1e-12);
         }
+    }
+
+    #[test]
+    fn kalman_gain_matches_the_generic_cholesky_solve() {
+        // A P and 24 rows H of the sizes of a 12-satellite epoch.
+        let p = StateMatrix::from_fn(|i, j| {
+            let d = (i as f64 - j as f64).abs();
+            (1.0 + 0.3 * i as f64) * (1.0 + 0.3 * j as f64) * (-0.4 * d).exp()
+        });
+        let h = DMatrix::from_fn(24, N, |i, j| ((i * 7 + j * 3) % 11) as f64 / 5.0 - 1.0);
+        let p_dyn = DMatrix::from_column_slice(N, N, p.as_slice());
+        let pht = &p_dyn * h.transpose();
+        let s = &h * &pht + DMatrix::identity(24, 24) * 4.0;
+        let s = (&s + s.transpose()) * 0.5;
+        let chol = s.cholesky().unwrap();
+        let ours = kalman_gain(chol.l_dirty(), &pht);
+        let generic = chol.solve(&pht.transpose()).transpose();
+        let scale = generic.amax();
+        assert!((ours - &generic).amax() <= 1e-12 * scale);
     }
 
     #[test]
