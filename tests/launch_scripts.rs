@@ -12,6 +12,15 @@ fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
 }
 
+/// A finished command's standard output when it succeeded, its standard error otherwise.
+fn stdout_or_stderr(out: &std::process::Output) -> Result<String, String> {
+    if out.status.success() {
+        Ok(String::from_utf8_lossy(&out.stdout).into_owned())
+    } else {
+        Err(String::from_utf8_lossy(&out.stderr).into_owned())
+    }
+}
+
 #[test]
 fn python_launch_file_parses_and_names_existing_things() {
     let launch = root().join("launch_scripts/gnss_ins_node.launch.py");
@@ -102,11 +111,7 @@ for old, new in node.kwargs['remappings']:
         .args(set.iter().map(|(n, v)| format!("{n}={v}")))
         .output()
         .expect("python3 is needed to check the launch file");
-    if out.status.success() {
-        Ok(String::from_utf8_lossy(&out.stdout).into_owned())
-    } else {
-        Err(String::from_utf8_lossy(&out.stderr).into_owned())
-    }
+    stdout_or_stderr(&out)
 }
 
 #[test]
@@ -187,11 +192,7 @@ fn shell_command(args: &[&str]) -> Result<String, String> {
         .env("GNSS_INS_DRY_RUN", "1")
         .output()
         .unwrap();
-    if out.status.success() {
-        Ok(String::from_utf8_lossy(&out.stdout).into_owned())
-    } else {
-        Err(String::from_utf8_lossy(&out.stderr).into_owned())
-    }
+    stdout_or_stderr(&out)
 }
 
 #[test]
