@@ -8,7 +8,9 @@ use adaptive_gnss_ins::earth::{llh_to_ecef, rot_ecef_to_enu, Llh};
 use adaptive_gnss_ins::gnss::ephemeris::{iono_free_coefficients, GroupDelay, RangingCode, Signal};
 use adaptive_gnss_ins::gnss::ionosphere::IonosphereMode;
 use adaptive_gnss_ins::gnss::spp::{solve_spp, SppConfig};
-use adaptive_gnss_ins::gnss::ubx::{build_epoch_with, read_ubx_log, sat_id, signal, UbxLog};
+use adaptive_gnss_ins::gnss::ubx::{
+    build_epoch_with, read_ubx_log, sat_id, signal, NavPvt, UbxLog,
+};
 use nalgebra::Vector3;
 
 fn log() -> UbxLog {
@@ -94,16 +96,19 @@ fn iono_free_epochs_combine_two_signals_with_their_group_delays() {
 }
 
 /// ENU error (m) of a solution against the NAV-PVT solution of the same epoch.
+/// The receiver's NAV-PVT solution (the reference) of the epoch at GPS time of week `tow_s`.
+fn reference_at(log: &UbxLog, tow_s: f64) -> Option<&NavPvt> {
+    log.nav_pvt
+        .iter()
+        .find(|p| (f64::from(p.itow_ms) * 1e-3 - tow_s).abs() < 0.05)
+}
+
 fn errors(log: &UbxLog, mode: IonosphereMode) -> Vec<Vector3<f64>> {
     let mut out = Vec::new();
     for raw in &log.rawx {
         let built = build_epoch_with(raw, &log.store, log.klobuchar, mode);
         let tow = built.receive_time.tow_s;
-        let Some(pvt) = log
-            .nav_pvt
-            .iter()
-            .find(|p| (f64::from(p.itow_ms) * 1e-3 - tow).abs() < 0.05)
-        else {
+        let Some(pvt) = reference_at(log, tow) else {
             continue;
         };
         let Ok(sol) = solve_spp(&built.epoch, &SppConfig::default()) else {
@@ -165,11 +170,7 @@ fn reference_residuals(log: &UbxLog) -> ReferenceResiduals {
     for raw in &log.rawx {
         let built = build_epoch_with(raw, &log.store, None, IonosphereMode::IonoFree);
         let tow = built.receive_time.tow_s;
-        let Some(pvt) = log
-            .nav_pvt
-            .iter()
-            .find(|p| (f64::from(p.itow_ms) * 1e-3 - tow).abs() < 0.05)
-        else {
+        let Some(pvt) = reference_at(log, tow) else {
             continue;
         };
         let reference = Llh::new(pvt.lat_rad, pvt.lon_rad, pvt.height_m);
