@@ -614,22 +614,11 @@ mod tests {
 
     #[test]
     fn loose_coupling_runs_on_fixes_and_counts_raw_epochs_as_wrong_coupling() {
-        use crate::sim::{Scenario, SimEvent};
-        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/params/ekf_loose.yaml");
-        let text = std::fs::read_to_string(path).unwrap();
-        let mut config = Config::from_yaml_str(&text, path).unwrap();
-        // The static scenario faces north (ENU yaw 90 deg); heading is not observable at rest.
-        config.set_parameter("init.heading_deg", "0.0").unwrap();
-        let mut core = NodeCore::new(config, OutputFrames::default());
-        let scenario = Scenario::builtin("static", 5).unwrap();
+        use crate::sim::SimEvent;
+        let mut core = loose_core(OutputFrames::default());
         let (mut odometry, mut epochs) = (0, 0);
         let mut out_had_tf = false;
-        for event in scenario.events() {
-            let event = event.unwrap();
-            if event.t_s() > 30.0 {
-                break;
-            }
-            let stamp = seconds_to_time(event.t_s()).unwrap();
+        for_each_static_event_30_s(|event, stamp| {
             let out = match event {
                 SimEvent::Imu(s) => core.on_imu(&outbound::imu(&s, stamp, "imu")),
                 SimEvent::Fix(f) => core.on_fix(&outbound::receiver_fix(&f, stamp, "gnss")),
@@ -644,7 +633,7 @@ mod tests {
                 .filter(|m| matches!(m, OutMsg::Odometry(_)))
                 .count();
             out_had_tf |= out.iter().any(|m| matches!(m, OutMsg::Tf(_)));
-        }
+        });
         assert!(odometry > 2000, "{odometry} odometry messages in 30 s");
         assert_eq!(core.counts().velocity_received, 0);
         assert!(!out_had_tf, "no /tf without publish_tf");
@@ -667,6 +656,20 @@ mod tests {
         NodeCore::new(config, frames)
     }
 
+    /// Calls `on_event` with the static scenario's events of its first 30 s, each with its
+    /// stamp.
+    fn for_each_static_event_30_s(mut on_event: impl FnMut(crate::sim::SimEvent, Time)) {
+        let scenario = crate::sim::Scenario::builtin("static", 5).unwrap();
+        for event in scenario.events() {
+            let event = event.unwrap();
+            if event.t_s() > 30.0 {
+                break;
+            }
+            let stamp = seconds_to_time(event.t_s()).unwrap();
+            on_event(event, stamp);
+        }
+    }
+
     /// The velocity message of a simulated fix (ENU twist, the linear covariance block).
     fn velocity_of(fix: &crate::engine::GnssFix, frame_id: &str) -> TwistWithCovarianceStamped {
         let stamp = seconds_to_time(fix.t_s).unwrap();
@@ -675,22 +678,16 @@ mod tests {
 
     #[test]
     fn velocities_pair_with_their_fixes_bad_ones_are_counted_and_tf_follows_odometry() {
-        use crate::sim::{Scenario, SimEvent};
+        use crate::sim::SimEvent;
         let frames = OutputFrames {
             map_frame: "map".to_owned(),
             base_frame: "imu_link".to_owned(),
             publish_tf: true,
         };
         let mut core = loose_core(frames);
-        let scenario = Scenario::builtin("static", 5).unwrap();
         let mut out = Vec::new();
         let (mut fixes, mut paired) = (0, 0);
-        for event in scenario.events() {
-            let event = event.unwrap();
-            if event.t_s() > 30.0 {
-                break;
-            }
-            let stamp = seconds_to_time(event.t_s()).unwrap();
+        for_each_static_event_30_s(|event, stamp| {
             match event {
                 SimEvent::Imu(s) => out.extend(core.on_imu(&outbound::imu(&s, stamp, "imu"))),
                 SimEvent::Fix(f) => {
@@ -721,7 +718,7 @@ mod tests {
                 }
                 _ => {}
             }
-        }
+        });
         let c = core.counts();
         assert!(fixes > 25, "{fixes} fixes");
         assert_eq!(c.velocity_received, fixes as u64 + 2);
@@ -772,17 +769,12 @@ mod tests {
 
     #[test]
     fn a_paired_velocity_reaches_the_filter() {
-        use crate::sim::{Scenario, SimEvent};
+        use crate::sim::SimEvent;
         // The receiver at rest claims 1 m/s east with σ 0.05 m/s: the filter must follow it.
         let speed_after = |bias_mps: f64| {
             let mut core = loose_core(OutputFrames::default());
             let mut last = None;
-            for event in Scenario::builtin("static", 5).unwrap().events() {
-                let event = event.unwrap();
-                if event.t_s() > 30.0 {
-                    break;
-                }
-                let stamp = seconds_to_time(event.t_s()).unwrap();
+            for_each_static_event_30_s(|event, stamp| {
                 let out = match event {
                     SimEvent::Imu(s) => core.on_imu(&outbound::imu(&s, stamp, "imu")),
                     SimEvent::Fix(mut f) => {
@@ -801,7 +793,7 @@ mod tests {
                         last = Some(nalgebra::Vector3::new(v.x, v.y, v.z).norm());
                     }
                 }
-            }
+            });
             assert!(core.counts().velocity_paired > 25);
             last.unwrap()
         };
