@@ -41,7 +41,7 @@ const IMU_TO_FLU_RPY_DEG: [f64; 3] = [0.0, 0.0, 90.0];
 
 /// Horizontal RMSE budget of the tightly-coupled EKF (params/walk_0827.yaml) against the
 /// RTK-fixed epochs (m), on the dual-frequency ionosphere-free pseudo-ranges (the
-/// `convert` default). Measured 6.533 m on 291 fixed epochs when this was set (README,
+/// `convert` default). Measured 6.533 m on 291 fixed epochs when this was set (docs/walk_0827.md,
 /// "Real data: walk_0827"); the budget is that plus about 7 %. (Single-frequency, with no
 /// ionosphere model in this 134 s log, the EKF measured 8.905 m.)
 ///
@@ -50,10 +50,10 @@ const IMU_TO_FLU_RPY_DEG: [f64; 3] = [0.0, 0.0, 90.0];
 /// ionosphere-free residuals at the reference positions fit an offset of the reference
 /// position of (5.4 E, 3.9 N, −0.6 U) m on average (`tests/iono_free_walk_0827.rs`); GPS
 /// alone and Galileo alone both put the antenna east of the reference. Not explained
-/// here (a datum offset of the reference would do it; see the README).
+/// here (a datum offset of the reference would do it; see docs/walk_0827.md).
 const TC_EKF_FIXED_HORIZONTAL_BUDGET_M: f64 = 7.0;
 
-/// The conversion `gnss_ins convert` does with the README's command line.
+/// The conversion `gnss_ins convert` does with the command line of docs/walk_0827.md.
 fn options() -> ConvertOptions {
     let d = walk_0827_support::dir();
     ConvertOptions {
