@@ -5,7 +5,8 @@
 //! is what a Jazzy system sends and expects:
 //! - a loosely-coupled bag played by rclpy with its time on /clock: every Odometry and
 //!   NavSatFix equals `gnss_ins replay`'s to the bit, /diagnostics and /rosout carry the
-//!   /clock times sent.
+//!   /clock times sent;
+//! - rclpy's parameter client lists, gets, types, describes and sets the parameters.
 //!
 //! Needs the venv made by `scripts/setup_test_peers.sh` (the README's test command and CI
 //! run it first); without it the tests fail and say so. Everything runs inside a private
@@ -134,4 +135,21 @@ fn jazzy_rclpy_plays_a_bag_and_receives_the_replay_solution() {
             .unwrap_or(0)
             >= 3
     );
+}
+
+/// rclpy's AsyncParameterClient (what `ros2 param` uses) against the node's parameter
+/// services in Fast DDS's request/reply layout: lists, values, types, a description for
+/// every parameter, an accepted set, sets refused with their reasons (read-only, out of
+/// range, wrong type) and an all-or-nothing atomic set.
+#[test]
+fn jazzy_parameter_client_lists_describes_and_sets_parameters() {
+    let python = venv_python();
+    if reexec_in_private_netns("jazzy_parameter_client_lists_describes_and_sets_parameters") {
+        return;
+    }
+    let _node = start_node(&[]);
+    let summary = run_peer(&python, "jazzy_parameters.py", &[]);
+    assert!(summary["listed"].as_u64().unwrap_or(0) > 50, "{summary}");
+    let reason = summary["refused_read_only"].as_str().unwrap_or_default();
+    assert!(reason.contains("read-only"), "{reason}");
 }
