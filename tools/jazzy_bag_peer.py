@@ -30,9 +30,9 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from jazzy_common import (  # noqa: E402  (the tools directory is not a package)
     Checks, JazzyNode, diagnostic_values, handshake, node_fqn, own_diagnostics, read_bag,
-    reliable, report, rosout_reader, stamp_ns, unconvertible_fix, unconvertible_imu, wait_until)
+    reliable, report, ros_time, rosout_reader, stamp_ns, unconvertible_fix, unconvertible_imu,
+    wait_until)
 
-from builtin_interfaces.msg import Time  # noqa: E402
 from diagnostic_msgs.msg import DiagnosticArray  # noqa: E402
 from geometry_msgs.msg import TwistWithCovarianceStamped  # noqa: E402
 from nav_msgs.msg import Odometry  # noqa: E402
@@ -89,11 +89,6 @@ class Peer:
             (p['/gnss/velocity'], bad_velocity, 'unconvertible_velocity')], checks)
 
 
-def clock_of(stamp_of_imu):
-    t = stamp_ns(stamp_of_imu) + CLOCK_ODD_NS
-    return Time(sec=t // 1_000_000_000, nanosec=t % 1_000_000_000)
-
-
 def stream(peer, inputs, speed, sim_time):
     """Publishes the inputs paced at `speed` times real time, the IMU sample after a fix at
     least GNSS_GAP_S later; returns the counts per topic and the /clock times sent (ns)."""
@@ -111,9 +106,8 @@ def stream(peer, inputs, speed, sim_time):
         peer.publishers[topic].publish(message)
         sent[topic] += 1
         if sim_time and topic == '/imu' and sent[topic] % CLOCK_EVERY_IMU == 0:
-            clock = clock_of(message.header.stamp)
-            peer.clock.publish(Clock(clock=clock))
-            clocks_ns.append(stamp_ns(clock))
+            clocks_ns.append(stamp_ns(message.header.stamp) + CLOCK_ODD_NS)
+            peer.clock.publish(Clock(clock=ros_time(clocks_ns[-1])))
     return sent, clocks_ns
 
 

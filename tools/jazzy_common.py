@@ -24,6 +24,7 @@ import time
 from pathlib import Path
 
 import rclpy
+from builtin_interfaces.msg import Time
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.serialization import deserialize_message
@@ -64,9 +65,17 @@ def rosout_reader():
                       durability=DurabilityPolicy.TRANSIENT_LOCAL)
 
 
+SECOND_NS = 1_000_000_000
+
+
 def stamp_ns(stamp):
     """A builtin_interfaces/Time as integer nanoseconds (exact)."""
-    return stamp.sec * 1_000_000_000 + stamp.nanosec
+    return stamp.sec * SECOND_NS + stamp.nanosec
+
+
+def ros_time(t_ns):
+    """Integer nanoseconds as a builtin_interfaces/Time (exact)."""
+    return Time(sec=t_ns // SECOND_NS, nanosec=t_ns % SECOND_NS)
 
 
 def wait_until(condition, timeout_s, step_s=0.05):

@@ -28,16 +28,14 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from jazzy_common import (  # noqa: E402  (the tools directory is not a package)
-    Checks, JazzyNode, handshake, node_fqn, reliable, report, stamp_ns, unconvertible_fix,
-    unconvertible_imu, wait_until)
+    SECOND_NS, Checks, JazzyNode, handshake, node_fqn, reliable, report, ros_time, stamp_ns,
+    unconvertible_fix, unconvertible_imu, wait_until)
 
-from builtin_interfaces.msg import Time  # noqa: E402
 from diagnostic_msgs.msg import DiagnosticArray  # noqa: E402
 from nav_msgs.msg import Odometry  # noqa: E402
 from rclpy.qos import qos_profile_sensor_data  # noqa: E402
 from sensor_msgs.msg import Imu, NavSatFix  # noqa: E402
 
-SECOND_NS = 1_000_000_000
 # 2025-06-15: f64 seconds resolve 238 ns here, not the nanoseconds of the stamps.
 EPOCH_NS = 1_750_000_000 * SECOND_NS
 IMU_PERIOD_NS = 5_000_000
@@ -53,10 +51,6 @@ DATUM = (39.10, 117.20, 10.0)
 def imu_stamp_ns(k):
     """x.0025 s, x.0075 s, ...; odd k one nanosecond later."""
     return EPOCH_NS + IMU_OFFSET_NS + k * IMU_PERIOD_NS + k % 2
-
-
-def ros_time(t_ns):
-    return Time(sec=t_ns // SECOND_NS, nanosec=t_ns % SECOND_NS)
 
 
 def imu_at(k):
