@@ -19,7 +19,6 @@ Prints a JSON summary on stdout, every failed check on stderr, and exits 1 if an
 See tools/jazzy_common.py for the environment.
 """
 
-import argparse
 import importlib.metadata
 import math
 import sys
@@ -29,9 +28,9 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from jazzy_common import (  # noqa: E402  (the tools directory is not a package)
-    Checks, JazzyNode, diagnostic_values, handshake, node_fqn, own_diagnostics, read_bag,
-    reliable, report, ros_time, rosout_reader, stamp_ns, unconvertible_fix, unconvertible_imu,
-    wait_until)
+    Checks, JazzyNode, argument_parser, diagnostic_values, handshake, node_fqn,
+    own_diagnostics, read_bag, reliable, report, ros_time, rosout_reader, stamp_ns,
+    unconvertible_fix, unconvertible_imu, wait_until)
 
 from diagnostic_msgs.msg import DiagnosticArray  # noqa: E402
 from geometry_msgs.msg import TwistWithCovarianceStamped  # noqa: E402
@@ -195,11 +194,9 @@ def check_rosout(checks, peer, clocks_ns):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.split('\n')[0])
+    parser = argument_parser(__doc__)
     parser.add_argument('--bag', required=True)
     parser.add_argument('--replay', required=True)
-    parser.add_argument('--namespace', required=True)
-    parser.add_argument('--node', required=True)
     parser.add_argument('--speed', type=float, default=4.0)
     parser.add_argument('--sim-time', action='store_true',
                         help='publish the bag time on /clock; the node runs with use_sim_time')

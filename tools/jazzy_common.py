@@ -16,6 +16,7 @@ What rclpy needs from the environment there:
 rclpy is initialised with `--disable-external-lib-logs`, so nothing is written to ~/.ros/log.
 """
 
+import argparse
 import json
 import math
 import sys
@@ -85,6 +86,15 @@ def wait_until(condition, timeout_s, step_s=0.05):
             return True
         time.sleep(step_s)
     return condition()
+
+
+def argument_parser(doc):
+    """The arguments of every peer: the node's namespace and name; described by the first
+    line of `doc`."""
+    parser = argparse.ArgumentParser(description=doc.split('\n')[0])
+    parser.add_argument('--namespace', required=True)
+    parser.add_argument('--node', required=True)
+    return parser
 
 
 def node_fqn(namespace, node):

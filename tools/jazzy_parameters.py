@@ -15,13 +15,12 @@ Prints a JSON summary on stdout, every failed check on stderr, and exits 1 if an
 See tools/jazzy_common.py for the environment.
 """
 
-import argparse
 import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from jazzy_common import (  # noqa: E402  (the tools directory is not a package)
-    Checks, JazzyNode, node_fqn, reliable, report, wait_until)
+    Checks, JazzyNode, argument_parser, node_fqn, reliable, report, wait_until)
 
 from rcl_interfaces.msg import ParameterEvent, ParameterType  # noqa: E402
 from rclpy.parameter import Parameter, parameter_value_to_python  # noqa: E402
@@ -163,9 +162,7 @@ def own_events(jazzy, fqn):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.split('\n')[0])
-    parser.add_argument('--namespace', required=True)
-    parser.add_argument('--node', required=True)
+    parser = argument_parser(__doc__)
     parser.add_argument('--require-parameter-events', action='store_true',
                         help='fail unless every accepted set is announced on /parameter_events')
     args = parser.parse_args()

@@ -21,15 +21,14 @@ Prints a JSON summary on stdout, every failed check on stderr, and exits 1 if an
 See tools/jazzy_common.py for the environment.
 """
 
-import argparse
 import sys
 import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from jazzy_common import (  # noqa: E402  (the tools directory is not a package)
-    SECOND_NS, Checks, JazzyNode, handshake, node_fqn, reliable, report, ros_time, stamp_ns,
-    unconvertible_fix, unconvertible_imu, wait_until)
+    SECOND_NS, Checks, JazzyNode, argument_parser, handshake, node_fqn, reliable, report,
+    ros_time, stamp_ns, unconvertible_fix, unconvertible_imu, wait_until)
 
 from diagnostic_msgs.msg import DiagnosticArray  # noqa: E402
 from nav_msgs.msg import Odometry  # noqa: E402
@@ -147,9 +146,7 @@ def latency_summary(odometry, published):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.split('\n')[0])
-    parser.add_argument('--namespace', required=True)
-    parser.add_argument('--node', required=True)
+    parser = argument_parser(__doc__)
     parser.add_argument('--duration-s', type=float, default=10.0)
     parser.add_argument('--exact-stamps', action='store_true',
                         help='fail unless every output carries exactly its IMU stamp')
