@@ -105,7 +105,7 @@ fn jazzy_rclpy_plays_a_bag_and_receives_the_replay_solution() {
     let dir = tempfile::tempdir().unwrap();
     let path = |name: &str| dir.path().join(name).to_str().unwrap().to_owned();
     let (bag, replayed, params) = (path("loose.mcap"), path("replay.mcap"), path("loose.yaml"));
-    // A `/**` file, as launch_ros writes one: the defaults but loose coupling.
+    // A `/**` parameter file for both: the defaults but loose coupling.
     std::fs::write(
         &params,
         "/**:\n  ros__parameters:\n    filter:\n      coupling: loose\n",
