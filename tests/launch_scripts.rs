@@ -8,6 +8,11 @@ use std::process::Command;
 
 use adaptive_gnss_ins::ros::node::params::{NODE_PARAMETERS, USE_SIM_TIME};
 
+/// The names of the node's own parameters.
+fn node_parameter_names() -> Vec<&'static str> {
+    NODE_PARAMETERS.iter().map(|p| p.name).collect()
+}
+
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
 }
@@ -118,7 +123,7 @@ for old, new in node.kwargs['remappings']:
 fn launch_file_declares_the_nodes_parameters_and_passes_only_those_set() {
     let printed = run_launch_file(&[]).unwrap();
     // Every node parameter is a launch argument whose default means "not set".
-    for name in NODE_PARAMETERS {
+    for name in node_parameter_names() {
         assert!(
             printed.lines().any(|l| l == format!("arg {name}=")),
             "no launch argument {name} defaulting to '':\n{printed}"
@@ -130,7 +135,7 @@ fn launch_file_declares_the_nodes_parameters_and_passes_only_those_set() {
         .filter_map(|l| l.strip_prefix("arg")?.trim().strip_suffix('='))
         .filter(|name| *name != "namespace")
         .collect();
-    let mut node = NODE_PARAMETERS.to_vec();
+    let mut node = node_parameter_names();
     not_set.sort_unstable();
     node.sort_unstable();
     assert_eq!(not_set, node);
@@ -197,7 +202,7 @@ fn shell_command(args: &[&str]) -> Result<String, String> {
 
 #[test]
 fn shell_script_passes_node_parameters_as_p() {
-    for name in NODE_PARAMETERS {
+    for name in node_parameter_names() {
         let set = format!("{name}:=x");
         let command = shell_command(&["ekf", &set, "-r", "__ns:=/robot"]).unwrap();
         assert!(

@@ -335,6 +335,24 @@ fn unknown_argument_is_rejected_with_a_clear_message() {
     assert!(stderr.contains("unknown argument `--bogus`"), "{stderr}");
 }
 
+/// Issue 16: `gnss_ins_node --help` was an error.
+#[test]
+fn help_prints_the_usage() {
+    for flag in ["--help", "-h"] {
+        let out = Command::new(env!("CARGO_BIN_EXE_gnss_ins_node"))
+            .arg(flag)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{flag}: {out:?}");
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(stdout.starts_with("Usage: gnss_ins_node"), "{stdout}");
+        assert!(
+            stdout.contains("--params-file") && stdout.contains("--log-level"),
+            "{stdout}"
+        );
+    }
+}
+
 #[test]
 fn params_file_for_another_node_is_rejected() {
     let params = concat!(env!("CARGO_MANIFEST_DIR"), "/params/ekf.yaml");

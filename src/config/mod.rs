@@ -38,7 +38,7 @@ pub use convert::{
 };
 pub use error::{ConfigError, QUOTED_CHARS};
 pub use file_value::ConstellationName;
-pub use param_file::{merge, NodeParameters, MAX_FILE_BYTES, MAX_NESTING_DEPTH};
+pub use param_file::{NodeParameters, MAX_FILE_BYTES, MAX_NESTING_DEPTH};
 pub use parameters::{
     AdaptiveConfig, ClockConfig, Config, EngineConfig, FilterConfig, GnssConfig, ImuConfig,
     InitConfig, LooseConfig, MountingConfig, OutputConfig, RobustConfig,

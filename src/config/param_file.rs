@@ -38,7 +38,7 @@ pub struct NodeParameters {
 
 impl NodeParameters {
     /// Sets `name` (replacing an earlier value in place, as rcl does).
-    pub fn set(&mut self, name: String, value: Value) {
+    fn set(&mut self, name: String, value: Value) {
         match self.values.iter_mut().find(|(n, _)| *n == name) {
             Some(slot) => slot.1 = value,
             None => self.values.push((name, value)),
@@ -48,7 +48,7 @@ impl NodeParameters {
 
 /// Adds `values` for `node` to `entries`: into the entry of the same node name when there
 /// is one (rcl keeps one entry per name, in the order names first appear).
-pub fn merge(entries: &mut Vec<NodeParameters>, node: &str, values: Vec<(String, Value)>) {
+fn merge(entries: &mut Vec<NodeParameters>, node: &str, values: Vec<(String, Value)>) {
     let index = match entries.iter().position(|e| e.node == node) {
         Some(i) => i,
         None => {
