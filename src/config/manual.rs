@@ -83,7 +83,7 @@ pub fn values_file(config: &Config) -> String {
 /// `params/ekf.yaml`: every parameter with its manual text, unit, range and default.
 pub fn manual_file() -> String {
     let mut text = String::new();
-    for paragraph in MANUAL_HEADER.split('\n') {
+    for paragraph in MANUAL_HEADER.lines() {
         comment(&mut text, "", paragraph);
     }
     comment(&mut text, "", "");
@@ -111,12 +111,12 @@ pub fn manual_file() -> String {
             };
             let null = if p.nullable { ", or null" } else { "" };
             let facts = format!(
-                "Unit: {unit}. Range: {}{null}. Run time: {}. Default: {}",
+                "Unit: {unit}. Range: {}{null}. Run time: {}.",
                 row.range,
                 if row.runtime { "yes" } else { "no" },
-                row.default
             );
             comment(&mut text, "      ", &facts);
+            comment(&mut text, "      ", &format!("Default: {}", row.default));
             let _ = writeln!(text, "      {}: {}", p.key(), row.default);
         }
     }

@@ -131,10 +131,12 @@ impl Range {
             Self::OffOrWithin(i) => x == 0.0 || i.contains(x),
             _ => return Err(self.misfit("a number")),
         };
-        if inside {
-            Ok(())
-        } else {
-            Err(format!("must be {}", self.text(unit)))
+        match (inside, self) {
+            (true, _) => Ok(()),
+            (false, Self::OffOrWithin(i)) => {
+                Err(format!("must be 0 (off) or in {}{}", i.text(), space(unit)))
+            }
+            (false, _) => Err(format!("must be in {}", self.text(unit))),
         }
     }
 
@@ -192,13 +194,13 @@ impl Range {
         }
     }
 
-    /// The range as the manual and the error messages state it, e.g. `in [1e-9, 1e6] m`.
+    /// The range as the manual states it, e.g. `[1e-9, 1e6] m`.
     pub fn text(&self, unit: &str) -> String {
         let unit = space(unit);
         match self {
             Self::Any => "any".to_owned(),
-            Self::Within(i) => format!("in {}{unit}", i.text()),
-            Self::OffOrWithin(i) => format!("0 (off) or in {}{unit}", i.text()),
+            Self::Within(i) => format!("{}{unit}", i.text()),
+            Self::OffOrWithin(i) => format!("0 (off) or {}{unit}", i.text()),
             Self::Count { min, max } => format!("an integer in [{min}, {max}]"),
             Self::Components(parts) => {
                 let mut text = String::new();

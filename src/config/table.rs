@@ -92,7 +92,7 @@ impl Parameter {
     pub fn range_text(&self) -> String {
         match (self.range, self.kind) {
             (Range::Any, Kind::Bool) => "true or false".to_owned(),
-            (Range::Any, Kind::Text) => "one of the names above".to_owned(),
+            (Range::Any, Kind::Text) => "a name the text lists".to_owned(),
             (range, _) => range.text(self.unit),
         }
     }
