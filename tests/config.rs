@@ -1,4 +1,5 @@
 //! The configuration loader against the preset files in `params/` and against bad input.
+//! Every preset but the manual (`params/ekf.yaml`) is an overlay loaded after it.
 
 use std::path::{Path, PathBuf};
 
@@ -7,6 +8,7 @@ use adaptive_gnss_ins::config::{
     RAD_S_PER_DEG_H,
 };
 use adaptive_gnss_ins::gnss::Constellation;
+use adaptive_gnss_ins::ros::node::params::config_from_files;
 use serde_yaml::Value;
 
 fn params_dir() -> PathBuf {
@@ -23,9 +25,10 @@ fn preset_files() -> Vec<PathBuf> {
     files
 }
 
+/// The preset `name` as it is meant to be loaded: over the manual.
 fn load(name: &str) -> Config {
-    let text = std::fs::read_to_string(params_dir().join(name)).unwrap();
-    Config::from_yaml_str(&text, name).unwrap()
+    config_from_files(&[params_dir().join("ekf.yaml"), params_dir().join(name)])
+        .unwrap_or_else(|e| panic!("{name}: {e}"))
 }
 
 /// A parameter file holding `body` (section lines indented by four spaces).
@@ -209,49 +212,52 @@ fn robust_constants_out_of_range_are_refused() {
     }
 }
 
-/// The manual can't drift: each preset lists every key, each key is preceded by a comment
-/// with its unit and its default, and that stated default is the built-in default.
+/// Each preset other than the manual holds only keys whose value differs from the
+/// manual's (so a preset says exactly how it differs).
 #[test]
-fn every_preset_documents_every_key_with_unit_and_true_default() {
+fn every_overlay_holds_only_what_differs_from_the_manual() {
     let defaults = Config::default().parameters();
     for path in preset_files() {
-        let text = std::fs::read_to_string(&path).unwrap();
-        let mut section = String::new();
-        let mut comment = String::new();
-        let mut documented = Vec::new();
-        for line in text.lines() {
-            let trimmed = line.trim_start();
-            let indent = line.len() - trimmed.len();
-            if let Some(c) = trimmed.strip_prefix('#') {
-                comment.push_str(c);
-                comment.push('\n');
-                continue;
-            }
-            if indent == 4 && trimmed.ends_with(':') {
-                section = trimmed.trim_end_matches(':').to_owned();
-            } else if indent == 6 {
-                let (key, _) = trimmed.split_once(':').unwrap();
-                let dotted = format!("{section}.{key}");
-                assert!(
-                    comment.contains("Unit:"),
-                    "{path:?} {dotted}: no `Unit:` in comment"
-                );
-                let stated = comment
-                    .split_once("Default:")
-                    .unwrap_or_else(|| panic!("{path:?} {dotted}: no `Default:` in comment"))
-                    .1
-                    .trim();
-                let stated: Value = serde_yaml::from_str(stated).unwrap();
-                let (_, default) = defaults.iter().find(|(k, _)| *k == dotted).unwrap();
-                assert_eq!(&stated, default, "{path:?} {dotted}: stated default");
-                documented.push(dotted);
-            }
-            comment.clear();
+        if path.ends_with("ekf.yaml") {
+            continue;
         }
-        let all: Vec<&String> = defaults.iter().map(|(k, _)| k).collect();
-        let documented: Vec<&String> = documented.iter().collect();
-        assert_eq!(documented, all, "{path:?}: keys listed");
+        let text = std::fs::read_to_string(&path).unwrap();
+        let entries = adaptive_gnss_ins::config::parse_parameter_file(&text, "p").unwrap();
+        assert_eq!(entries.len(), 1, "{path:?}");
+        assert!(!entries[0].values.is_empty(), "{path:?}");
+        for (name, value) in &entries[0].values {
+            let (_, default) = defaults
+                .iter()
+                .find(|(k, _)| k == name)
+                .unwrap_or_else(|| panic!("{path:?}: unknown {name}"));
+            assert_ne!(
+                value, default,
+                "{path:?}: {name} repeats the manual's default"
+            );
+        }
     }
+}
+
+/// Issue 10: turning the presets into overlays keeps each one's effective configuration:
+/// the full file it was (tests/data/presets_before_overlays) loads to the same
+/// configuration as the manual followed by the overlay.
+#[test]
+fn every_overlay_over_the_manual_is_the_full_preset_it_replaced() {
+    let before = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/presets_before_overlays");
+    let mut compared = 0;
+    for path in preset_files() {
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        if name == "ekf.yaml" {
+            continue;
+        }
+        let full = std::fs::read_to_string(before.join(&name))
+            .unwrap_or_else(|e| panic!("{name}: no full preset to compare with: {e}"));
+        let full = Config::from_yaml_str(&full, &name).unwrap();
+        assert_eq!(load(&name), full, "{name}");
+        assert_ne!(full, Config::default(), "{name}");
+        compared += 1;
+    }
+    assert_eq!(compared, 11);
 }
 
 #[test]

@@ -355,7 +355,15 @@ fn help_prints_the_usage() {
 
 #[test]
 fn params_file_for_another_node_is_rejected() {
-    let params = concat!(env!("CARGO_MANIFEST_DIR"), "/params/ekf.yaml");
+    // The shipped presets are keyed `/**` (every node); this file names its node.
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("named.yaml");
+    std::fs::write(
+        &file,
+        "gnss_ins_node:\n  ros__parameters:\n    filter.variant: ermakf\n",
+    )
+    .unwrap();
+    let params = file.to_str().unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_gnss_ins_node"))
         .args(["--ros-args", "--params-file", params, "-r", "__node:=other"])
         .output()

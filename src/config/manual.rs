@@ -7,10 +7,10 @@ use std::fmt::Write as _;
 use super::table::yaml_text;
 use super::{parameter_table, sections, Config, Parameter};
 
-/// The node name the echo is written under: ROS 2 applies it to every node.
+/// The node name the echo and the presets are written under: rcl applies it to every
+/// node, whatever its name and namespace (a preset keyed `gnss_ins_node` would not reach
+/// a node in a namespace: that key means `/gnss_ins_node`).
 const WILDCARD_NODE: &str = "/**";
-/// The node name of the shipped presets.
-const PRESET_NODE: &str = "gnss_ins_node";
 /// Width of the manual's comment lines.
 const WIDTH: usize = 90;
 
@@ -31,6 +31,7 @@ after it (a later file wins):
   gnss_ins replay BAG --params params/ekf.yaml --params params/ermakf.yaml
 Override one key:  --ros-args -p imu.gyro_bias_deg_per_h:=0.3
 
+The parameters are keyed `/**`, so they reach the node under any name and namespace.
 Units are in the key names and converted to SI once at load time. Frames: navigation ENU, \
 body FLU (REP-103); IMU data is specific force (REP-145).
 ";
@@ -94,7 +95,7 @@ pub fn manual_file() -> String {
          this file, and regenerate with:",
     );
     comment(&mut text, "", &format!("  {REGENERATE}"));
-    let _ = write!(text, "\n{PRESET_NODE}:\n  ros__parameters:\n");
+    let _ = write!(text, "\n{WILDCARD_NODE}:\n  ros__parameters:\n");
     for (k, (section, doc)) in sections().enumerate() {
         if k > 0 {
             text.push('\n');

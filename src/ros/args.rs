@@ -16,7 +16,7 @@ use std::path::PathBuf;
 
 use super::log_level::{LogLevelError, LogLevelRule};
 
-/// The default node name (the params files of `params/` are keyed by it).
+/// The default node name.
 pub const DEFAULT_NODE_NAME: &str = "gnss_ins_node";
 
 /// A `--params-file` or a `-p` rule, in command-line order.
