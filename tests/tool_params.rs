@@ -50,7 +50,11 @@ fn replay_takes_the_manual_then_a_launch_style_file() {
     ]);
     assert!(succeeded(&out).contains("solutions"));
     // A file for another node is refused, naming it.
-    std::fs::write(&file, "other_node:\n  ros__parameters:\n    filter.variant: ermakf\n").unwrap();
+    std::fs::write(
+        &file,
+        "other_node:\n  ros__parameters:\n    filter.variant: ermakf\n",
+    )
+    .unwrap();
     let out = gnss_ins(&["replay", BAG, "--params", file.to_str().unwrap()]);
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("other_node"));

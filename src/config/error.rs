@@ -136,7 +136,7 @@ impl ConfigError {
 }
 
 /// Longest quotation of input text in an error message (characters).
-pub const QUOTED_CHARS: usize = 80;
+const QUOTED_CHARS: usize = 80;
 
 fn location_suffix(line: Option<usize>, column: Option<usize>) -> String {
     match (line, column) {

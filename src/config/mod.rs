@@ -36,9 +36,8 @@ pub use convert::{
     si_to_human, M_S2_PER_UG, RAD_PER_DEG, RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H, RAD_S_PER_DEG_H,
     STANDARD_GRAVITY_M_S2,
 };
-pub use error::{ConfigError, QUOTED_CHARS};
-pub use file_value::ConstellationName;
-pub use param_file::{NodeParameters, MAX_FILE_BYTES, MAX_NESTING_DEPTH};
+pub use error::ConfigError;
+pub use param_file::{NodeParameters, MAX_FILE_BYTES};
 pub use parameters::{
     AdaptiveConfig, ClockConfig, Config, EngineConfig, FilterConfig, GnssConfig, ImuConfig,
     InitConfig, LooseConfig, MountingConfig, OutputConfig, RobustConfig,

@@ -206,7 +206,7 @@ pub fn node_params_from(values: &[Assignment]) -> Result<NodeParams, ParamsError
         .iter()
         .partition(|a| NodeParameter::named(&a.name).is_some());
     let config = Config::default().with(core.into_iter().cloned())?;
-    let value = |name: &str| own.iter().rev().find(|a| a.name == name).copied();
+    let value = |name: &str| own.iter().find(|a| a.name == name).copied();
     let defaults = OutputFrames::default();
     let frames = OutputFrames {
         map_frame: frame(value(MAP_FRAME), MAP_FRAME, &defaults.map_frame)?,
@@ -502,6 +502,26 @@ mod tests {
             matches!(&e, ParamsError::Config(c) if matches!(**c, ConfigError::TooLarge { .. })),
             "{e}"
         );
+    }
+
+    #[test]
+    fn declared_defaults_are_the_loaded_ones() {
+        let p = load_with(&[], &[]).unwrap();
+        let loaded = [
+            (USE_SIM_TIME, Value::Bool(p.use_sim_time)),
+            (MAP_FRAME, p.frames.map_frame.into()),
+            (BASE_FRAME, p.frames.base_frame.into()),
+            (PUBLISH_TF, Value::Bool(p.frames.publish_tf)),
+            (QUEUE_DEPTH, Value::from(p.queue_depth)),
+        ];
+        for (name, value) in loaded {
+            let declared = NodeParameter::named(name).unwrap().default;
+            assert_eq!(
+                serde_yaml::from_str::<Value>(declared).unwrap(),
+                value,
+                "{name}"
+            );
+        }
     }
 
     #[test]
