@@ -5,8 +5,10 @@
         publish_tf:=true base_frame:=imu_link
 
 Arguments:
-- params_file (default: params/ekf.yaml next to this directory), namespace, node_name,
-  log_level;
+- params_file: a parameter file loaded after the manual params/ekf.yaml (which holds
+  every parameter at its default): a preset of params/ (they hold only what differs from
+  the manual) or a file of your own; default: the manual itself (loaded once).
+  namespace, node_name, log_level;
 - imu_topic, gnss_topic, fix_topic, velocity_topic, odometry_topic: remappings of the
   node's relative topics imu, gnss/measurements, gnss/fix, gnss/velocity and odometry;
 - the node's own parameters use_sim_time (bool), map_frame, base_frame (frame ids),
@@ -26,7 +28,8 @@ from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
 
 PACKAGE_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-DEFAULT_PARAMS = os.path.join(PACKAGE_ROOT, 'params', 'ekf.yaml')
+# The manual: every parameter at its default; the presets are overlays on it.
+MANUAL_PARAMS = os.path.join(PACKAGE_ROOT, 'params', 'ekf.yaml')
 
 # The node's own parameters (src/ros/node/params.rs, NODE_PARAMETERS): name -> (type,
 # description). The descriptions name the node's defaults.
@@ -77,7 +80,12 @@ def _launch_node(context):
     def value(name):
         return LaunchConfiguration(name).perform(context)
 
-    parameters = [value('params_file')]
+    # rcl reads the files in order and a later value wins: the manual, then the preset,
+    # then the overrides (launch_ros writes them to a temporary file passed last).
+    parameters = [MANUAL_PARAMS]
+    params_file = value('params_file')
+    if params_file and os.path.abspath(params_file) != MANUAL_PARAMS:
+        parameters.append(params_file)
     overrides = node_parameter_overrides({name: value(name) for name in NODE_PARAMETERS})
     if overrides:
         parameters.append(overrides)
@@ -95,8 +103,9 @@ def _launch_node(context):
 
 def generate_launch_description():
     arguments = [
-        DeclareLaunchArgument('params_file', default_value=DEFAULT_PARAMS,
-                              description='ROS 2 parameter file (a preset of params/)'),
+        DeclareLaunchArgument('params_file', default_value=MANUAL_PARAMS,
+                              description='parameter file loaded after params/ekf.yaml (a '
+                                          'preset of params/ or your own)'),
         DeclareLaunchArgument('namespace', default_value='',
                               description='namespace of the node and its topics'),
         DeclareLaunchArgument('node_name', default_value='gnss_ins_node',

@@ -4,7 +4,8 @@
 #
 #   launch_scripts/run_node_with_preset.sh [PRESET] [NAME:=VALUE ...] [extra ROS arguments]
 #
-# PRESET is a file name of params/ without .yaml (default: ermakf), e.g. ekf, ekf_loose.
+# PRESET is a file name of params/ without .yaml (default: ermakf), e.g. ekf, ekf_loose;
+# it is loaded after the manual params/ekf.yaml (the presets hold only what differs).
 # NAME:=VALUE sets one of the node's own parameters as the launch file's arguments do:
 # use_sim_time, map_frame, base_frame, publish_tf, queue_depth (passed as -p NAME:=VALUE,
 # which wins over the preset). Extra arguments follow --ros-args, e.g. -r __ns:=/robot
@@ -18,10 +19,16 @@ node_parameters=(use_sim_time map_frame base_frame publish_tf queue_depth)
 repo_root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 preset="${1:-ermakf}"
 shift $(( $# >= 1 ? 1 : 0 ))
+manual="${repo_root}/params/ekf.yaml"
 params="${repo_root}/params/${preset}.yaml"
 if [[ ! -f "${params}" ]]; then
     echo "$0: no preset ${params}" >&2
     exit 2
+fi
+# The manual, then the preset (a later file wins; the manual is not given twice).
+params_files=(--params-file "${manual}")
+if [[ "${params}" != "${manual}" ]]; then
+    params_files+=(--params-file "${params}")
 fi
 
 # Leading NAME:=VALUE arguments of node parameters become -p NAME:=VALUE.
@@ -41,7 +48,7 @@ while [[ $# -gt 0 && "$1" == *:=* ]]; do
 done
 
 command=(cargo run --quiet --release --manifest-path "${repo_root}/Cargo.toml" --bin gnss_ins_node --
-    --ros-args --params-file "${params}" "${ros_args[@]}" "$@")
+    --ros-args "${params_files[@]}" "${ros_args[@]}" "$@")
 if [[ "${GNSS_INS_DRY_RUN:-}" == 1 ]]; then
     printf '%s\n' "${command[*]}"
     exit 0

@@ -1,4 +1,5 @@
 //! The configuration loader against the preset files in `params/` and against bad input.
+//! Every preset but the manual (`params/ekf.yaml`) is an overlay loaded after it.
 
 use std::path::{Path, PathBuf};
 
@@ -7,6 +8,7 @@ use adaptive_gnss_ins::config::{
     RAD_S_PER_DEG_H,
 };
 use adaptive_gnss_ins::gnss::Constellation;
+use adaptive_gnss_ins::ros::node::params::config_from_files;
 use serde_yaml::Value;
 
 fn params_dir() -> PathBuf {
@@ -23,9 +25,10 @@ fn preset_files() -> Vec<PathBuf> {
     files
 }
 
+/// The preset `name` as it is meant to be loaded: over the manual.
 fn load(name: &str) -> Config {
-    let text = std::fs::read_to_string(params_dir().join(name)).unwrap();
-    Config::from_yaml_str(&text, name).unwrap()
+    config_from_files(&[params_dir().join("ekf.yaml"), params_dir().join(name)])
+        .unwrap_or_else(|e| panic!("{name}: {e}"))
 }
 
 /// A parameter file holding `body` (section lines indented by four spaces).
@@ -209,49 +212,52 @@ fn robust_constants_out_of_range_are_refused() {
     }
 }
 
-/// The manual can't drift: each preset lists every key, each key is preceded by a comment
-/// with its unit and its default, and that stated default is the built-in default.
+/// Each preset other than the manual holds only keys whose value differs from the
+/// manual's (so a preset says exactly how it differs).
 #[test]
-fn every_preset_documents_every_key_with_unit_and_true_default() {
+fn every_overlay_holds_only_what_differs_from_the_manual() {
     let defaults = Config::default().parameters();
     for path in preset_files() {
-        let text = std::fs::read_to_string(&path).unwrap();
-        let mut section = String::new();
-        let mut comment = String::new();
-        let mut documented = Vec::new();
-        for line in text.lines() {
-            let trimmed = line.trim_start();
-            let indent = line.len() - trimmed.len();
-            if let Some(c) = trimmed.strip_prefix('#') {
-                comment.push_str(c);
-                comment.push('\n');
-                continue;
-            }
-            if indent == 4 && trimmed.ends_with(':') {
-                section = trimmed.trim_end_matches(':').to_owned();
-            } else if indent == 6 {
-                let (key, _) = trimmed.split_once(':').unwrap();
-                let dotted = format!("{section}.{key}");
-                assert!(
-                    comment.contains("Unit:"),
-                    "{path:?} {dotted}: no `Unit:` in comment"
-                );
-                let stated = comment
-                    .split_once("Default:")
-                    .unwrap_or_else(|| panic!("{path:?} {dotted}: no `Default:` in comment"))
-                    .1
-                    .trim();
-                let stated: Value = serde_yaml::from_str(stated).unwrap();
-                let (_, default) = defaults.iter().find(|(k, _)| *k == dotted).unwrap();
-                assert_eq!(&stated, default, "{path:?} {dotted}: stated default");
-                documented.push(dotted);
-            }
-            comment.clear();
+        if path.ends_with("ekf.yaml") {
+            continue;
         }
-        let all: Vec<&String> = defaults.iter().map(|(k, _)| k).collect();
-        let documented: Vec<&String> = documented.iter().collect();
-        assert_eq!(documented, all, "{path:?}: keys listed");
+        let text = std::fs::read_to_string(&path).unwrap();
+        let entries = adaptive_gnss_ins::config::parse_parameter_file(&text, "p").unwrap();
+        assert_eq!(entries.len(), 1, "{path:?}");
+        assert!(!entries[0].values.is_empty(), "{path:?}");
+        for (name, value) in &entries[0].values {
+            let (_, default) = defaults
+                .iter()
+                .find(|(k, _)| k == name)
+                .unwrap_or_else(|| panic!("{path:?}: unknown {name}"));
+            assert_ne!(
+                value, default,
+                "{path:?}: {name} repeats the manual's default"
+            );
+        }
     }
+}
+
+/// Issue 10: turning the presets into overlays keeps each one's effective configuration:
+/// the full file it was (tests/data/presets_before_overlays) loads to the same
+/// configuration as the manual followed by the overlay.
+#[test]
+fn every_overlay_over_the_manual_is_the_full_preset_it_replaced() {
+    let before = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/presets_before_overlays");
+    let mut compared = 0;
+    for path in preset_files() {
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        if name == "ekf.yaml" {
+            continue;
+        }
+        let full = std::fs::read_to_string(before.join(&name))
+            .unwrap_or_else(|e| panic!("{name}: no full preset to compare with: {e}"));
+        let full = Config::from_yaml_str(&full, &name).unwrap();
+        assert_eq!(load(&name), full, "{name}");
+        assert_ne!(full, Config::default(), "{name}");
+        compared += 1;
+    }
+    assert_eq!(compared, 11);
 }
 
 #[test]
@@ -378,7 +384,11 @@ fn unknown_keys_are_refused_with_their_full_name() {
 
     let e = load_error("    imus:\n      gyro_bias_deg_per_h: 0.5\n");
     assert!(matches!(e, ConfigError::UnknownKey { .. }), "{e:?}");
-    assert_names(&e, "imus", "test.yaml");
+    assert_names(&e, "imus.gyro_bias_deg_per_h", "test.yaml");
+    assert!(
+        e.to_string().contains("imu, mounting"),
+        "known sections listed: {e}"
+    );
 }
 
 #[test]
@@ -492,7 +502,7 @@ fn out_of_range_values_are_refused_with_their_full_name() {
     let e = load_error("    imu:\n      gyro_bias_deg_per_h: -0.5\n");
     assert_eq!(
         e.to_string(),
-        "test.yaml: parameter `imu.gyro_bias_deg_per_h` = -0.5: must be finite and > 0"
+        "test.yaml: parameter `imu.gyro_bias_deg_per_h` = -0.5: must be in [1e-9, 1e6] deg/h"
     );
 }
 
@@ -584,4 +594,88 @@ fn set_parameter_applies_and_validates() {
         .unwrap_err();
     assert!(matches!(e, ConfigError::Yaml { .. }), "{e:?}");
     assert_eq!(config, before);
+}
+
+/// Issue 12 items 1-3, 6, 9 and 12: counts, windows and orders have an upper bound,
+/// physical quantities a physical range, and a configuration that can never start names
+/// the parameter that prevents it; each is refused at load, naming the key.
+#[test]
+fn absurd_values_are_refused_naming_the_key() {
+    for (section, key, value) in [
+        ("adaptive", "window_size_m", "18446744073709551615"),
+        ("adaptive", "ar_max_order", "18446744073709551614"),
+        ("adaptive", "window_size_m", "1000000000"),
+        ("adaptive", "innovation_window", "1000000000"),
+        ("robust", "residual_window_epochs", "1000000000"),
+        ("robust", "q_window_epochs", "1000000000"),
+        ("init", "position_sigma_m", "1e300"),
+        ("imu", "gyro_bias_deg_per_h", "1e300"),
+        ("imu", "gyro_markov_correlation_time_s", "1e-300"),
+        ("init", "min_satellites", "1000"),
+        ("engine", "max_imu_gap_s", "1e-300"),
+        ("engine", "imu_buffer_s", "1e300"),
+    ] {
+        let body = format!("    {section}:\n      {key}: {value}\n");
+        let e = load_error(&body);
+        assert!(matches!(e, ConfigError::Invalid { .. }), "{body}: {e:?}");
+        assert_names(&e, &format!("{section}.{key}"), "test.yaml");
+    }
+    // The largest AR order with the smallest window it needs loads (no overflow anywhere).
+    let body = "    adaptive: {ar_max_order: 100, min_samples: 102, window_size_m: 10000}\n";
+    assert!(Config::from_yaml_str(&file(body), "t").is_ok());
+    let e = load_error("    adaptive: {ar_max_order: 100, min_samples: 30}\n");
+    assert_names(&e, "adaptive.min_samples", "test.yaml");
+}
+
+/// Issue 12 item 5: an error quotes at most a short prefix of a value or a key.
+#[test]
+fn a_huge_value_or_key_is_quoted_by_a_short_prefix() {
+    let huge = "x".repeat(200_000);
+    for (body, quoted) in [
+        (
+            format!("    imu:\n      gyro_bias_deg_per_h: {huge}\n"),
+            true,
+        ),
+        (
+            format!("    gnss:\n      constellations: [gps, {huge}]\n"),
+            true,
+        ),
+        (format!("    imu:\n      ? {huge}\n      : 1.0\n"), true),
+        // YAML itself refuses a plain key of more than 1024 characters.
+        (format!("    imu:\n      {huge}: 1.0\n"), false),
+    ] {
+        let e = load_error(&body).to_string();
+        assert!(e.len() < 600, "{} bytes: {}...", e.len(), &e[..200]);
+        assert_eq!(e.contains(" bytes)"), quoted, "{e}");
+    }
+}
+
+/// Issue 12 item 5: size and nesting are checked before the YAML parser sees the text,
+/// so 500,000 nested `[` are refused at once instead of hanging the loader.
+#[test]
+fn deep_or_large_files_are_refused_before_parsing() {
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let deep = format!("/**:\n  ros__parameters:\n    a: {}", "[".repeat(500_000));
+        let _ = tx.send(Config::from_yaml_str(&deep, "deep.yaml"));
+    });
+    // The timeout only keeps a regression from hanging the test suite.
+    let result = rx
+        .recv_timeout(std::time::Duration::from_secs(120))
+        .expect("loading 500,000 nested brackets hangs");
+    let e = result.unwrap_err();
+    assert!(matches!(e, ConfigError::TooDeep { line: 3, .. }), "{e}");
+    assert!(e.to_string().contains("deep.yaml"), "{e}");
+
+    let large = file(&format!("    # {}\n", "x".repeat(2 << 20)));
+    let e = Config::from_yaml_str(&large, "large.yaml").unwrap_err();
+    assert!(matches!(e, ConfigError::TooLarge { .. }), "{e}");
+    // A file of 64 levels is parsed (and refused for what it holds, not for its depth).
+    let nested = format!(
+        "/**:\n  ros__parameters:\n    a: {}1{}\n",
+        "[".repeat(61),
+        "]".repeat(61)
+    );
+    let e = Config::from_yaml_str(&nested, "ok.yaml").unwrap_err();
+    assert!(matches!(e, ConfigError::UnknownKey { .. }), "{e}");
 }

@@ -1,12 +1,23 @@
 //! The launch files of launch_scripts/: the Python launch file parses and names files and
 //! topics that exist, declares the node's own parameters (by the node's names) and passes
-//! only those the user set; the shell script is valid bash, refuses an unknown preset and
-//! passes the node's parameters as `-p`.
+//! only those the user set, and the node loads the command line launch_ros 0.26 builds
+//! from it (reproduced here from launch_ros's source, temporary file included); the
+//! shell scripts are valid bash, refuse an unknown preset, load the preset after the
+//! manual and pass the node's parameters as `-p`.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use adaptive_gnss_ins::ros::node::params::{NODE_PARAMETERS, USE_SIM_TIME};
+use adaptive_gnss_ins::config::{Config, Coupling};
+use adaptive_gnss_ins::ros::args::parse;
+use adaptive_gnss_ins::ros::node::params::{
+    config_from_files, load, NodeParams, NODE_PARAMETERS, USE_SIM_TIME,
+};
+
+/// The names of the node's own parameters.
+fn node_parameter_names() -> Vec<&'static str> {
+    NODE_PARAMETERS.iter().map(|p| p.name).collect()
+}
 
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -61,13 +72,28 @@ fn python_launch_file_parses_and_names_existing_things() {
     }
 }
 
-/// Runs the launch file under stand-ins of the `launch` and `launch_ros` modules (no ROS
-/// here), resolves its OpaqueFunction with the launch arguments `set` (name, value; the
-/// others keep their defaults) and returns what it printed: one line per declared argument
-/// (`arg NAME=DEFAULT`), then `parameters REPR` and `remap FROM TO` of the node.
-fn run_launch_file(set: &[(&str, &str)]) -> Result<String, String> {
-    const HARNESS: &str = r#"
-import sys, types
+/// The Python side of the launch tests: the launch file run under stand-ins of the
+/// `launch` and `launch_ros` modules (there is no ROS here), its OpaqueFunction resolved
+/// with the launch arguments given as NAME=VALUE (the others keep their defaults).
+///
+/// Mode `describe` prints one line per declared argument (`arg NAME=DEFAULT`), then
+/// `parameters REPR` (the node's parameters after the manual) and `remap FROM TO`.
+///
+/// Mode `argv` prints, as JSON, the command line launch_ros 0.26 (Jazzy) builds for the
+/// node, writing the temporary parameter file as it does. Read from launch_ros 0.26.6,
+/// launch_ros/actions/node.py (`Node.__init__`, `_perform_substitutions`, `execute`,
+/// `_create_params_file_from_dict`), utilities/namespace_utils.py (`prefix_namespace`,
+/// `make_namespace_absolute`), utilities/normalize_parameters.py (nested dicts flattened
+/// to dotted names) and utilities/evaluate_parameters.py (string values through YAML):
+/// the executable, `arguments`, `--ros-args`, `-r __node:=NAME` (when named), `-r __ns:=NS`
+/// (when a namespace is given, made absolute), one `--params-file` per file or dict in
+/// order (a dict written to `NamedTemporaryFile(prefix='launch_params_')` with
+/// `yaml.dump({NODE: {'ros__parameters': dict}}, default_flow_style=False)`, NODE the
+/// fully qualified name when name and namespace are known, else `/**`), then the
+/// remappings as `-r FROM:=TO`. Mode `node` does the same for Node keyword arguments
+/// given as JSON instead of the launch file's.
+const HARNESS: &str = r#"
+import json, os, sys, tempfile, types
 def module(name, **members):
     m = types.ModuleType(name)
     m.__dict__.update(members)
@@ -84,41 +110,252 @@ module('launch', LaunchDescription=Record)
 module('launch.actions', DeclareLaunchArgument=Record, OpaqueFunction=Record)
 module('launch.substitutions', LaunchConfiguration=LaunchConfiguration)
 module('launch_ros'); module('launch_ros.actions', Node=Record)
-launch = {'__file__': sys.argv[1]}
-exec(compile(open(sys.argv[1]).read(), sys.argv[1], 'exec'), launch)
+
+def prefix_namespace(base, ns):
+    if base is None and ns is None:
+        return None
+    if ns is None:
+        combined = base
+    elif not base or ns.startswith('/'):
+        combined = ns
+    else:
+        combined = ('' if base == '/' else base) + '/' + ns
+    return combined if combined == '/' else combined.rstrip('/')
+
+def flatten(params, prefix=''):
+    import yaml
+    flat = {}
+    for name, value in params.items():
+        name = prefix + '.' + name if prefix else name
+        if isinstance(value, dict):
+            flat.update(flatten(value, name))
+        elif isinstance(value, str):
+            flat[name] = yaml.safe_load(yaml.dump(value))
+        else:
+            flat[name] = value
+    return flat
+
+def launch_ros_argv(executable, kw):
+    import yaml
+    cmd = [executable] + list(kw.get('arguments') or [])
+    if kw.get('ros_arguments') is not None:
+        cmd += ['--ros-args'] + list(kw['ros_arguments'])
+    cmd += ['--ros-args']
+    name, namespace = kw.get('name'), kw.get('namespace')
+    if name is not None:
+        cmd += ['-r', '__node:=' + name]
+    final_ns = '<node_namespace_unspecified>'
+    if namespace is not None:
+        ns = prefix_namespace(None, namespace)
+        final_ns = ns if ns.startswith('/') else '/' + ns
+        cmd += ['-r', '__ns:=' + final_ns]
+    node_name = prefix_namespace(final_ns, name if name is not None else '<node_name_unspecified>')
+    specified = 'unspecified>' not in node_name
+    for params in kw.get('parameters') or []:
+        if isinstance(params, dict):
+            with tempfile.NamedTemporaryFile(mode='w', prefix='launch_params_', delete=False) as h:
+                key = node_name if specified else '/**'
+                yaml.dump({key: {'ros__parameters': flatten(params)}}, h, default_flow_style=False)
+                params = h.name
+        cmd += ['--params-file', str(params)]
+    for old, new in kw.get('remappings') or []:
+        cmd += ['-r', old + ':=' + new]
+    return cmd
+
+mode = sys.argv[1]
+if mode == 'node':
+    print(json.dumps(launch_ros_argv('gnss_ins_node', json.loads(sys.argv[2]))))
+    sys.exit(0)
+launch = {'__file__': sys.argv[2]}
+exec(compile(open(sys.argv[2]).read(), sys.argv[2], 'exec'), launch)
 description = launch['generate_launch_description']()
 context = {}
 for action in description.args[0]:
     if action.args:
         name, default = action.args[0], action.kwargs['default_value']
-        print(f'arg {name}={default}')
+        if mode == 'describe':
+            print(f'arg {name}={default}')
         context[name] = default
     else:
         opaque = action
-for pair in sys.argv[2:]:
+for pair in sys.argv[3:]:
     name, value = pair.split('=', 1)
     context[name] = value
 (node,) = opaque.kwargs['function'](context)
-print('parameters', repr(node.kwargs['parameters'][1:]))
-for old, new in node.kwargs['remappings']:
-    print('remap', old, new)
+if mode == 'describe':
+    print('parameters', repr(node.kwargs['parameters'][1:]))
+    for old, new in node.kwargs['remappings']:
+        print('remap', old, new)
+else:
+    print(json.dumps(launch_ros_argv('gnss_ins_node', node.kwargs)))
 "#;
-    let launch = root().join("launch_scripts/gnss_ins_node.launch.py");
+
+/// Runs the harness in `mode` with `args`, from the package root (where `ros2 launch`
+/// is run in the README), and returns its standard output.
+fn harness(mode: &str, args: &[String]) -> Result<String, String> {
     let out = Command::new("python3")
+        .current_dir(root())
         .arg("-c")
         .arg(HARNESS)
-        .arg(&launch)
-        .args(set.iter().map(|(n, v)| format!("{n}={v}")))
+        .arg(mode)
+        .args(args)
         .output()
         .expect("python3 is needed to check the launch file");
     stdout_or_stderr(&out)
+}
+
+/// The launch file resolved with the launch arguments `set` (name, value), in `mode`.
+fn run_launch_file_in(mode: &str, set: &[(&str, &str)]) -> Result<String, String> {
+    let launch = root().join("launch_scripts/gnss_ins_node.launch.py");
+    let mut args = vec![launch.display().to_string()];
+    args.extend(set.iter().map(|(n, v)| format!("{n}={v}")));
+    harness(mode, &args)
+}
+
+/// What the launch file declares and passes to the node (mode `describe`).
+fn run_launch_file(set: &[(&str, &str)]) -> Result<String, String> {
+    run_launch_file_in("describe", set)
+}
+
+/// The argv launch_ros 0.26 gives the node, and the temporary files in it.
+struct LaunchedArgv {
+    argv: Vec<String>,
+    temporary: Vec<PathBuf>,
+}
+
+impl LaunchedArgv {
+    fn parse(json: &str) -> Self {
+        let argv: Vec<String> = serde_json::from_str(json.trim()).unwrap();
+        let temporary = argv
+            .iter()
+            .filter(|a| {
+                Path::new(a)
+                    .file_name()
+                    .is_some_and(|f| f.to_string_lossy().starts_with("launch_params_"))
+            })
+            .map(PathBuf::from)
+            .collect();
+        Self { argv, temporary }
+    }
+
+    /// The node's parameters as it loads them from this command line.
+    fn load(&self) -> NodeParams {
+        let args = parse(self.argv[1..].iter().cloned()).unwrap();
+        load(&args).unwrap_or_else(|e| panic!("{e}\n{:?}", self.argv))
+    }
+}
+
+impl Drop for LaunchedArgv {
+    fn drop(&mut self) {
+        for file in &self.temporary {
+            let _ = std::fs::remove_file(file);
+        }
+    }
+}
+
+/// Issue 16: the README's own launch example failed with "only one --params-file is
+/// supported": launch_ros writes the overrides to a temporary file and passes it as a
+/// further --params-file.
+#[test]
+fn the_readme_launch_example_loads_as_launch_ros_runs_it() {
+    let json = run_launch_file_in(
+        "argv",
+        &[
+            ("params_file", "params/ekf_loose.yaml"),
+            ("publish_tf", "true"),
+            ("base_frame", "imu_link"),
+            ("velocity_topic", "/ublox/fix_velocity"),
+        ],
+    )
+    .unwrap();
+    let launched = LaunchedArgv::parse(&json);
+    let manual = root().join("params/ekf.yaml").display().to_string();
+    let argv: Vec<&str> = launched.argv.iter().map(String::as_str).collect();
+    assert_eq!(
+        argv[..16],
+        [
+            "gnss_ins_node",
+            "--ros-args",
+            "--log-level",
+            "info",
+            "--ros-args",
+            "-r",
+            "__node:=gnss_ins_node",
+            "-r",
+            "__ns:=/",
+            "--params-file",
+            manual.as_str(),
+            "--params-file",
+            "params/ekf_loose.yaml",
+            "--params-file",
+            launched.temporary[0].to_str().unwrap(),
+            "-r",
+        ],
+        "{argv:?}"
+    );
+    assert!(
+        argv.contains(&"gnss/velocity:=/ublox/fix_velocity"),
+        "{argv:?}"
+    );
+    // The temporary file, byte for byte as PyYAML writes it for launch_ros.
+    assert_eq!(
+        std::fs::read_to_string(&launched.temporary[0]).unwrap(),
+        "/gnss_ins_node:\n  ros__parameters:\n    base_frame: imu_link\n    publish_tf: true\n"
+    );
+    let p = launched.load();
+    assert_eq!(p.frames.base_frame, "imu_link");
+    assert!(p.frames.publish_tf);
+    assert_eq!(
+        p.config.filter.coupling,
+        Coupling::Loose,
+        "the preset applies"
+    );
+    let mut expected = Config::default();
+    expected.filter.coupling = Coupling::Loose;
+    assert_eq!(p.config, expected);
+}
+
+#[test]
+fn a_launch_in_a_namespace_addresses_the_fully_qualified_name() {
+    let json = run_launch_file_in(
+        "argv",
+        &[
+            ("namespace", "robot"),
+            ("params_file", "params/iarf.yaml"),
+            ("use_sim_time", "true"),
+        ],
+    )
+    .unwrap();
+    let launched = LaunchedArgv::parse(&json);
+    assert!(launched.argv.contains(&"__ns:=/robot".to_owned()));
+    let text = std::fs::read_to_string(&launched.temporary[0]).unwrap();
+    assert!(text.starts_with("/robot/gnss_ins_node:\n"), "{text}");
+    let p = launched.load();
+    assert!(p.use_sim_time);
+    assert_eq!(p.config.filter.variant.as_str(), "iarf");
+}
+
+/// launch_ros flattens a nested dict to dotted names, under `/**` when the node has no
+/// name in the launch file.
+#[test]
+fn a_nested_parameter_dict_arrives_as_dotted_keys_under_the_wildcard() {
+    let node = r#"{"parameters": [{"filter": {"variant": "ermakf"}, "gnss": {"elevation_mask_deg": 15.0}, "publish_tf": true}]}"#;
+    let launched = LaunchedArgv::parse(&harness("node", &[node.to_owned()]).unwrap());
+    assert_eq!(
+        std::fs::read_to_string(&launched.temporary[0]).unwrap(),
+        "/**:\n  ros__parameters:\n    filter.variant: ermakf\n    gnss.elevation_mask_deg: 15.0\n    publish_tf: true\n"
+    );
+    let p = launched.load();
+    assert_eq!(p.config.filter.variant.as_str(), "ermakf");
+    assert!((p.config.gnss.elevation_mask_rad - 15f64.to_radians()).abs() < 1e-15);
+    assert!(p.frames.publish_tf);
 }
 
 #[test]
 fn launch_file_declares_the_nodes_parameters_and_passes_only_those_set() {
     let printed = run_launch_file(&[]).unwrap();
     // Every node parameter is a launch argument whose default means "not set".
-    for name in NODE_PARAMETERS {
+    for name in node_parameter_names() {
         assert!(
             printed.lines().any(|l| l == format!("arg {name}=")),
             "no launch argument {name} defaulting to '':\n{printed}"
@@ -130,7 +367,7 @@ fn launch_file_declares_the_nodes_parameters_and_passes_only_those_set() {
         .filter_map(|l| l.strip_prefix("arg")?.trim().strip_suffix('='))
         .filter(|name| *name != "namespace")
         .collect();
-    let mut node = NODE_PARAMETERS.to_vec();
+    let mut node = node_parameter_names();
     not_set.sort_unstable();
     node.sort_unstable();
     assert_eq!(not_set, node);
@@ -197,7 +434,7 @@ fn shell_command(args: &[&str]) -> Result<String, String> {
 
 #[test]
 fn shell_script_passes_node_parameters_as_p() {
-    for name in NODE_PARAMETERS {
+    for name in node_parameter_names() {
         let set = format!("{name}:=x");
         let command = shell_command(&["ekf", &set, "-r", "__ns:=/robot"]).unwrap();
         assert!(
@@ -209,6 +446,55 @@ fn shell_script_passes_node_parameters_as_p() {
     }
     let plain = shell_command(&["ekf"]).unwrap();
     assert!(plain.trim_end().ends_with("params/ekf.yaml"), "{plain}");
+    assert_eq!(plain.matches("--params-file").count(), 1, "{plain}");
     let e = shell_command(&["ekf", "map_frme:=odom"]).unwrap_err();
     assert!(e.contains("map_frme is not a node parameter"), "{e}");
+}
+
+/// The words after `--` of a printed `cargo run ... -- ARGS` command.
+fn program_args(command: &str) -> Vec<String> {
+    let words: Vec<&str> = command.split_whitespace().collect();
+    let start = words.iter().position(|w| *w == "--").unwrap() + 1;
+    words[start..].iter().map(|w| w.to_string()).collect()
+}
+
+/// The scripts load a preset after the manual, and the node (and replay) read that
+/// command line to the preset's configuration.
+#[test]
+fn shell_scripts_load_the_preset_over_the_manual() {
+    let command = shell_command(&["ermakf", "publish_tf:=true"]).unwrap();
+    let manual = root().join("params/ekf.yaml");
+    let preset = root().join("params/ermakf.yaml");
+    assert!(
+        command.contains(&format!(
+            "--params-file {} --params-file {} -p publish_tf:=true",
+            manual.display(),
+            preset.display()
+        )),
+        "{command}"
+    );
+    let p = load(&parse(program_args(&command)).unwrap()).unwrap();
+    assert_eq!(p.config.filter.variant.as_str(), "ermakf");
+    assert!(p.frames.publish_tf);
+
+    let out = Command::new("bash")
+        .arg(root().join("launch_scripts/replay_with_preset.sh"))
+        .args(["bag.mcap", "walk_0827"])
+        .env("GNSS_INS_DRY_RUN", "1")
+        .output()
+        .unwrap();
+    let command = stdout_or_stderr(&out).unwrap();
+    let words = program_args(&command);
+    let files: Vec<PathBuf> = words
+        .windows(2)
+        .filter(|w| w[0] == "--params")
+        .map(|w| PathBuf::from(&w[1]))
+        .collect();
+    assert_eq!(
+        files,
+        vec![manual, root().join("params/walk_0827.yaml")],
+        "{command}"
+    );
+    let config = config_from_files(&files).unwrap();
+    assert_eq!(config.init.leveling_duration_s, 5.0);
 }

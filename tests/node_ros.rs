@@ -335,9 +335,35 @@ fn unknown_argument_is_rejected_with_a_clear_message() {
     assert!(stderr.contains("unknown argument `--bogus`"), "{stderr}");
 }
 
+/// Issue 16: `gnss_ins_node --help` was an error.
+#[test]
+fn help_prints_the_usage() {
+    for flag in ["--help", "-h"] {
+        let out = Command::new(env!("CARGO_BIN_EXE_gnss_ins_node"))
+            .arg(flag)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{flag}: {out:?}");
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(stdout.starts_with("Usage: gnss_ins_node"), "{stdout}");
+        assert!(
+            stdout.contains("--params-file") && stdout.contains("--log-level"),
+            "{stdout}"
+        );
+    }
+}
+
 #[test]
 fn params_file_for_another_node_is_rejected() {
-    let params = concat!(env!("CARGO_MANIFEST_DIR"), "/params/ekf.yaml");
+    // The shipped presets are keyed `/**` (every node); this file names its node.
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("named.yaml");
+    std::fs::write(
+        &file,
+        "gnss_ins_node:\n  ros__parameters:\n    filter.variant: ermakf\n",
+    )
+    .unwrap();
+    let params = file.to_str().unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_gnss_ins_node"))
         .args(["--ros-args", "--params-file", params, "-r", "__node:=other"])
         .output()

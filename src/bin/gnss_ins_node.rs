@@ -1,20 +1,26 @@
-//! `gnss_ins_node`: the ROS 2 node. Takes only ROS arguments, e.g.
-//! `gnss_ins_node --ros-args --params-file params/ekf.yaml -r imu:=/sensors/imu`.
+//! `gnss_ins_node`: the ROS 2 node. Takes ROS arguments as rcl does, e.g.
+//! `gnss_ins_node --ros-args --params-file params/ekf.yaml -r imu:=/sensors/imu`
+//! (`gnss_ins_node --help` lists them).
 
 use std::process::ExitCode;
 
-use adaptive_gnss_ins::ros::{args, node};
+use adaptive_gnss_ins::ros::{args, log_level, node};
 
 fn main() -> ExitCode {
     let cli = match args::parse(std::env::args().skip(1)) {
         Ok(a) => a,
         Err(e) => return fail(&e),
     };
-    // Choice: without RUST_LOG, RustDDS logs only errors (its warnings about unreachable
-    // locators flood a host without multicast), ros2-client warnings, the rest at --log-level.
-    let level = cli.log_level.as_deref().unwrap_or("info");
-    let filter = format!("{level},rustdds=error,ros2_client=warn");
+    if cli.help {
+        print!("{}", args::USAGE);
+        return ExitCode::SUCCESS;
+    }
+    let logger = node::rosout::logger_name(&cli.fully_qualified_name());
+    let (filter, unknown_loggers) = log_level::env_filter(&cli.log_levels, &logger);
     let log_lines = node::rosout::init_logging(&filter);
+    for warning in cli.ignored.iter().chain(&unknown_loggers) {
+        log::warn!("{warning}");
+    }
     let params = match node::params::load(&cli) {
         Ok(c) => c,
         Err(e) => return fail(&e),

@@ -1,4 +1,5 @@
-//! Human units <-> SI, done once at load time (forward) and for the echo (backward).
+//! Human units <-> SI, done once at load time (forward) and for the echo (backward): the
+//! conversions the parameter table names.
 //!
 //! Forward conversion is always `human * FACTOR`; the backward conversion picks the human
 //! value whose forward conversion gives back the very same SI bits, so echoing a loaded
@@ -6,9 +7,9 @@
 
 use nalgebra::{UnitQuaternion, Vector3};
 
-use super::raw::{RawClock, RawConfig, RawGnss, RawImu, RawInit, RawMounting, RawOutput};
-use super::{ClockConfig, Config, GnssConfig, ImuConfig, InitConfig, MountingConfig, OutputConfig};
+use super::file_value::ConstellationName;
 use crate::earth::Llh;
+use crate::gnss::Constellation;
 
 /// Standard gravity (m/s²) defining the unit g (and µg) of accelerometer data sheets.
 pub const STANDARD_GRAVITY_M_S2: f64 = 9.806_65;
@@ -63,159 +64,161 @@ fn rpy_deg_from_rotation(q: &UnitQuaternion<f64>) -> [f64; 3] {
     [roll, pitch, yaw].map(|rad| (rad / RAD_PER_DEG * STEPS_PER_DEG).round() / STEPS_PER_DEG + 0.0)
 }
 
-impl From<&RawConfig> for Config {
-    /// Converts to SI. The conversion cannot fail; validation is a separate step.
-    fn from(raw: &RawConfig) -> Self {
-        let RawConfig {
-            filter,
-            imu,
-            mounting,
-            clock,
-            gnss,
-            loose,
-            adaptive,
-            robust,
-            init,
-            engine,
-            output,
-        } = raw;
-        Config {
-            filter: filter.clone(),
-            imu: ImuConfig {
-                gyro_arw_rad_per_sqrt_s: imu.gyro_arw_deg_per_sqrt_h
-                    * RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H,
-                gyro_bias_sigma_rad_s: imu.gyro_bias_deg_per_h * RAD_S_PER_DEG_H,
-                gyro_markov_sigma_rad_s: imu.gyro_markov_sigma_deg_per_h * RAD_S_PER_DEG_H,
-                gyro_markov_time_s: imu.gyro_markov_correlation_time_s,
-                accel_vrw_m_s_per_sqrt_s: imu.accel_vrw_ug_per_sqrt_hz * M_S2_PER_UG,
-                accel_bias_sigma_m_s2: imu.accel_bias_ug * M_S2_PER_UG,
-                accel_markov_time_s: imu.accel_bias_correlation_time_s,
-            },
-            mounting: MountingConfig {
-                imu_to_body: rotation_from_rpy(&mounting.imu_rotation_rpy_deg),
-                lever_arm_b_m: Vector3::from(mounting.antenna_lever_arm_m),
-            },
-            clock: ClockConfig {
-                bias_noise_m_per_sqrt_s: clock.bias_noise_m_per_sqrt_s,
-                drift_noise_m_s_per_sqrt_s: clock.drift_noise_mps_per_sqrt_s,
-                drift_time_s: clock.drift_correlation_time_s,
-            },
-            gnss: GnssConfig {
-                elevation_mask_rad: gnss.elevation_mask_deg * RAD_PER_DEG,
-                cn0_mask_dbhz: gnss.cn0_mask_dbhz,
-                pseudorange_sigma_m: gnss.pseudorange_sigma_m,
-                pseudorange_rate_sigma_mps: gnss.pseudorange_rate_sigma_mps,
-                elevation_weighting: gnss.elevation_weighting,
-                use_receiver_sigmas: gnss.use_receiver_sigmas,
-                use_pseudorange_rate: gnss.use_pseudorange_rate,
-                innovation_gate_sigma: gnss.innovation_gate_sigma,
-                constellations: gnss.constellations.iter().map(|&c| c.into()).collect(),
-                max_clock_jump_m: gnss.clock_jump_threshold_m,
-            },
-            loose: loose.clone(),
-            adaptive: adaptive.clone(),
-            robust: robust.clone(),
-            init: InitConfig {
-                heading_rad: init.heading_deg.map(|deg| deg * RAD_PER_DEG),
-                heading_min_speed_mps: init.heading_min_speed_mps,
-                leveling_duration_s: init.leveling_duration_s,
-                min_satellites: init.min_satellites,
-                attitude_sigma_rad: init.attitude_sigma_deg * RAD_PER_DEG,
-                heading_sigma_rad: init.heading_sigma_deg * RAD_PER_DEG,
-                velocity_sigma_mps: init.velocity_sigma_mps,
-                position_sigma_m: init.position_sigma_m,
-                clock_bias_sigma_m: init.clock_bias_sigma_m,
-                clock_drift_sigma_mps: init.clock_drift_sigma_mps,
-            },
-            engine: engine.clone(),
-            output: OutputConfig {
-                datum: output.datum_llh_deg_m.map(|[lat_deg, lon_deg, height_m]| {
-                    Llh::new(lat_deg * RAD_PER_DEG, lon_deg * RAD_PER_DEG, height_m)
-                }),
-                rate_hz: output.rate_hz,
-            },
-        }
+/// How a parameter's value in the file (human units) becomes the configuration's (SI),
+/// and back for the echo: the backward conversion gives the value whose forward
+/// conversion reproduces the SI bits, so an echo loads back to the same configuration.
+pub trait Convert<Human, Si> {
+    /// File value to SI.
+    fn to_si(&self, human: &Human) -> Si;
+    /// SI to file value.
+    fn to_human(&self, si: &Si) -> Human;
+}
+
+/// What the manual says about a conversion (`1 deg = 0.017453 rad`), empty for none.
+pub trait ConversionText {
+    /// The conversion of one `unit` of the file.
+    fn text(&self, unit: &str) -> String;
+}
+
+/// No conversion: the file value is the SI value.
+pub struct Same;
+
+impl<T: Clone> Convert<T, T> for Same {
+    fn to_si(&self, human: &T) -> T {
+        human.clone()
+    }
+    fn to_human(&self, si: &T) -> T {
+        si.clone()
     }
 }
 
-impl From<&Config> for RawConfig {
-    /// Converts back to the human units of the parameter file.
-    fn from(config: &Config) -> Self {
-        let Config {
-            filter,
-            imu,
-            mounting,
-            clock,
-            gnss,
-            loose,
-            adaptive,
-            robust,
-            init,
-            engine,
-            output,
-        } = config;
+impl ConversionText for Same {
+    fn text(&self, _: &str) -> String {
+        String::new()
+    }
+}
+
+/// SI = file value × `factor`, in `si_unit`.
+pub struct Scale {
+    pub si_unit: &'static str,
+    pub factor: f64,
+}
+
+impl Scale {
+    /// The conversion to `si_unit` by `factor`.
+    pub const fn to(si_unit: &'static str, factor: f64) -> Self {
+        Self { si_unit, factor }
+    }
+}
+
+impl Convert<f64, f64> for Scale {
+    fn to_si(&self, human: &f64) -> f64 {
+        human * self.factor
+    }
+    fn to_human(&self, si: &f64) -> f64 {
+        si_to_human(*si, self.factor)
+    }
+}
+
+impl Convert<Option<f64>, Option<f64>> for Scale {
+    fn to_si(&self, human: &Option<f64>) -> Option<f64> {
+        human.map(|h| h * self.factor)
+    }
+    fn to_human(&self, si: &Option<f64>) -> Option<f64> {
+        si.map(|s| si_to_human(s, self.factor))
+    }
+}
+
+impl ConversionText for Scale {
+    fn text(&self, unit: &str) -> String {
+        format!("1 {unit} = {} {}", significant(self.factor), self.si_unit)
+    }
+}
+
+/// `[roll, pitch, yaw]` in degrees to the rotation R = Rz(yaw) · Ry(pitch) · Rx(roll).
+pub struct RpyDegToRotation;
+
+impl Convert<[f64; 3], UnitQuaternion<f64>> for RpyDegToRotation {
+    fn to_si(&self, human: &[f64; 3]) -> UnitQuaternion<f64> {
+        rotation_from_rpy(human)
+    }
+    fn to_human(&self, si: &UnitQuaternion<f64>) -> [f64; 3] {
+        rpy_deg_from_rotation(si)
+    }
+}
+
+impl ConversionText for RpyDegToRotation {
+    fn text(&self, _: &str) -> String {
+        "the rotation R = Rz(yaw) Ry(pitch) Rx(roll)".to_owned()
+    }
+}
+
+/// Three components to a vector of the same unit.
+pub struct ToVector;
+
+impl Convert<[f64; 3], Vector3<f64>> for ToVector {
+    fn to_si(&self, human: &[f64; 3]) -> Vector3<f64> {
+        Vector3::from(*human)
+    }
+    fn to_human(&self, si: &Vector3<f64>) -> [f64; 3] {
+        (*si).into()
+    }
+}
+
+impl ConversionText for ToVector {
+    fn text(&self, _: &str) -> String {
+        String::new()
+    }
+}
+
+/// `[lat_deg, lon_deg, height_m]` to a geodetic position in radians and metres.
+pub struct LlhDegToPosition;
+
+impl Convert<Option<[f64; 3]>, Option<Llh>> for LlhDegToPosition {
+    fn to_si(&self, human: &Option<[f64; 3]>) -> Option<Llh> {
+        human.map(|[lat_deg, lon_deg, height_m]| {
+            Llh::new(lat_deg * RAD_PER_DEG, lon_deg * RAD_PER_DEG, height_m)
+        })
+    }
+    fn to_human(&self, si: &Option<Llh>) -> Option<[f64; 3]> {
         let deg = |rad: f64| si_to_human(rad, RAD_PER_DEG);
-        RawConfig {
-            filter: filter.clone(),
-            imu: RawImu {
-                gyro_arw_deg_per_sqrt_h: si_to_human(
-                    imu.gyro_arw_rad_per_sqrt_s,
-                    RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H,
-                ),
-                gyro_bias_deg_per_h: si_to_human(imu.gyro_bias_sigma_rad_s, RAD_S_PER_DEG_H),
-                gyro_markov_sigma_deg_per_h: si_to_human(
-                    imu.gyro_markov_sigma_rad_s,
-                    RAD_S_PER_DEG_H,
-                ),
-                gyro_markov_correlation_time_s: imu.gyro_markov_time_s,
-                accel_vrw_ug_per_sqrt_hz: si_to_human(imu.accel_vrw_m_s_per_sqrt_s, M_S2_PER_UG),
-                accel_bias_ug: si_to_human(imu.accel_bias_sigma_m_s2, M_S2_PER_UG),
-                accel_bias_correlation_time_s: imu.accel_markov_time_s,
-            },
-            mounting: RawMounting {
-                imu_rotation_rpy_deg: rpy_deg_from_rotation(&mounting.imu_to_body),
-                antenna_lever_arm_m: mounting.lever_arm_b_m.into(),
-            },
-            clock: RawClock {
-                bias_noise_m_per_sqrt_s: clock.bias_noise_m_per_sqrt_s,
-                drift_noise_mps_per_sqrt_s: clock.drift_noise_m_s_per_sqrt_s,
-                drift_correlation_time_s: clock.drift_time_s,
-            },
-            gnss: RawGnss {
-                elevation_mask_deg: deg(gnss.elevation_mask_rad),
-                cn0_mask_dbhz: gnss.cn0_mask_dbhz,
-                pseudorange_sigma_m: gnss.pseudorange_sigma_m,
-                pseudorange_rate_sigma_mps: gnss.pseudorange_rate_sigma_mps,
-                elevation_weighting: gnss.elevation_weighting,
-                use_receiver_sigmas: gnss.use_receiver_sigmas,
-                use_pseudorange_rate: gnss.use_pseudorange_rate,
-                innovation_gate_sigma: gnss.innovation_gate_sigma,
-                constellations: gnss.constellations.iter().map(|&c| c.into()).collect(),
-                clock_jump_threshold_m: gnss.max_clock_jump_m,
-            },
-            loose: loose.clone(),
-            adaptive: adaptive.clone(),
-            robust: robust.clone(),
-            init: RawInit {
-                heading_deg: init.heading_rad.map(deg),
-                heading_min_speed_mps: init.heading_min_speed_mps,
-                leveling_duration_s: init.leveling_duration_s,
-                min_satellites: init.min_satellites,
-                attitude_sigma_deg: deg(init.attitude_sigma_rad),
-                heading_sigma_deg: deg(init.heading_sigma_rad),
-                velocity_sigma_mps: init.velocity_sigma_mps,
-                position_sigma_m: init.position_sigma_m,
-                clock_bias_sigma_m: init.clock_bias_sigma_m,
-                clock_drift_sigma_mps: init.clock_drift_sigma_mps,
-            },
-            engine: engine.clone(),
-            output: RawOutput {
-                datum_llh_deg_m: output
-                    .datum
-                    .map(|p| [deg(p.lat_rad), deg(p.lon_rad), p.height_m]),
-                rate_hz: output.rate_hz,
-            },
-        }
+        si.map(|p| [deg(p.lat_rad), deg(p.lon_rad), p.height_m])
+    }
+}
+
+impl ConversionText for LlhDegToPosition {
+    fn text(&self, _: &str) -> String {
+        format!(
+            "latitude and longitude: 1 deg = {} rad",
+            significant(RAD_PER_DEG)
+        )
+    }
+}
+
+/// Constellation names to the GNSS layer's constellations.
+pub struct ByName;
+
+impl Convert<Vec<ConstellationName>, Vec<Constellation>> for ByName {
+    fn to_si(&self, human: &Vec<ConstellationName>) -> Vec<Constellation> {
+        human.iter().map(|&c| c.into()).collect()
+    }
+    fn to_human(&self, si: &Vec<Constellation>) -> Vec<ConstellationName> {
+        si.iter().map(|&c| c.into()).collect()
+    }
+}
+
+impl ConversionText for ByName {
+    fn text(&self, _: &str) -> String {
+        String::new()
+    }
+}
+
+/// `x` with five significant digits: `2.9089e-4`, `0.017453`.
+fn significant(x: f64) -> String {
+    let text = format!("{x:.4e}");
+    match text.split_once('e') {
+        Some((mantissa, "0")) => mantissa.to_owned(),
+        _ => text,
     }
 }
 

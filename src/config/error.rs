@@ -50,6 +50,23 @@ pub enum ConfigError {
         value: String,
         reason: String,
     },
+    /// The text is larger than a parameter file can be (checked before parsing).
+    #[error("{origin}: larger than the limit of {limit} bytes for a parameter file")]
+    TooLarge { origin: String, limit: usize },
+    /// The text nests deeper than a parameter file can (checked before parsing).
+    #[error("{origin}: nested deeper than {limit} levels at line {line}; a parameter file nests about 5")]
+    TooDeep {
+        origin: String,
+        line: usize,
+        limit: usize,
+    },
+    /// A node name that rcl refuses in a parameter file.
+    #[error(
+        "{origin}: node name `{name}` is not valid: rcl takes letters, digits and `_` \
+         between the slashes, or the wildcards `*` (one token) and `**` (any tokens) as whole \
+         tokens, e.g. `/**`, `/**/gnss_ins_node`"
+    )]
+    BadNodeName { origin: String, name: String },
 }
 
 impl ConfigError {
@@ -60,7 +77,10 @@ impl ConfigError {
             | Self::Layout { origin, .. }
             | Self::UnknownKey { origin, .. }
             | Self::WrongType { origin, .. }
-            | Self::Invalid { origin, .. } => origin,
+            | Self::Invalid { origin, .. }
+            | Self::TooLarge { origin, .. }
+            | Self::TooDeep { origin, .. }
+            | Self::BadNodeName { origin, .. } => origin,
         }
     }
 
@@ -70,10 +90,53 @@ impl ConfigError {
             Self::UnknownKey { key, .. }
             | Self::WrongType { key, .. }
             | Self::Invalid { key, .. } => Some(key),
-            Self::Yaml { .. } | Self::Layout { .. } => None,
+            Self::Yaml { .. }
+            | Self::Layout { .. }
+            | Self::TooLarge { .. }
+            | Self::TooDeep { .. }
+            | Self::BadNodeName { .. } => None,
+        }
+    }
+
+    /// At most [`QUOTED_CHARS`] characters of a text from the input, for a message.
+    ///
+    /// Choice: an error quotes a short prefix of what it refers to and its length, so
+    /// that a 100 MB value does not come back on stderr, `/rosout` or in a service reply.
+    pub fn shortened(text: &str) -> String {
+        match text.char_indices().nth(QUOTED_CHARS) {
+            None => text.to_owned(),
+            Some((end, _)) => format!("{}... ({} bytes)", &text[..end], text.len()),
+        }
+    }
+
+    pub(super) fn layout(origin: &str, found: String) -> Self {
+        Self::Layout {
+            origin: origin.to_owned(),
+            sections: super::section_names().join(", "),
+            found,
+        }
+    }
+
+    pub(super) fn yaml(e: &serde_yaml::Error, origin: &str) -> Self {
+        let location = e.location();
+        let line = location.as_ref().map(|l| l.line());
+        let column = location.as_ref().map(|l| l.column());
+        let mut message = e.to_string();
+        if let (Some(line), Some(column)) = (line, column) {
+            // The parser's own text repeats the location that the error's Display shows.
+            message = message.replace(&format!(" at line {line} column {column}"), "");
+        }
+        Self::Yaml {
+            origin: origin.to_owned(),
+            line,
+            column,
+            message: Self::shortened(&message),
         }
     }
 }
+
+/// Longest quotation of input text in an error message (characters).
+const QUOTED_CHARS: usize = 80;
 
 fn location_suffix(line: Option<usize>, column: Option<usize>) -> String {
     match (line, column) {

@@ -1,35 +1,28 @@
 //! Changing parameters of a running engine (the node's `set_parameters` service).
 
-use crate::config::Config;
+use std::sync::LazyLock;
+
+use crate::config::{parameter_table, Config};
 
 use super::Engine;
 
 /// The parameters (dotted names of the parameter file) a running engine takes over at
-/// once, without a restart.
+/// once, without a restart: those the parameter table marks `at_run_time`.
 ///
-/// Choice: exactly those the engine reads from its configuration at every use and from
-/// which it derives no state: the satellite masks, gate and fixed σ model of `gnss.*`, the
-/// fix weighting of `loose.*`, the IMU gap limit and the output rate. Everything else is
-/// built into the filter when the engine starts (the variant, the process noise from
-/// `imu.*` and `clock.*`, the adaptive and robust estimators' constants, the mounting, the
-/// start-up settings, the buffer length) and changing it would need a new filter, which
-/// for a moving vehicle means a new levelling at rest.
-pub const RUNTIME_PARAMETERS: &[&str] = &[
-    "gnss.elevation_mask_deg",
-    "gnss.cn0_mask_dbhz",
-    "gnss.pseudorange_sigma_m",
-    "gnss.pseudorange_rate_sigma_mps",
-    "gnss.elevation_weighting",
-    "gnss.use_receiver_sigmas",
-    "gnss.innovation_gate_sigma",
-    "gnss.clock_jump_threshold_m",
-    "loose.use_fix_covariance",
-    "loose.fix_sigma_horizontal_m",
-    "loose.fix_sigma_vertical_m",
-    "loose.velocity_sigma_mps",
-    "engine.max_imu_gap_s",
-    "output.rate_hz",
-];
+/// Choice (in the table): exactly those the engine reads from its configuration at every
+/// use and from which it derives no state: the satellite masks, gate and fixed σ model of
+/// `gnss.*`, the fix weighting of `loose.*`, the IMU gap limit and the output rate.
+/// Everything else is built into the filter when the engine starts (the variant, the
+/// process noise from `imu.*` and `clock.*`, the adaptive and robust estimators'
+/// constants, the mounting, the start-up settings, the buffer length) and changing it
+/// would need a new filter, which for a moving vehicle means a new levelling at rest.
+pub static RUNTIME_PARAMETERS: LazyLock<Vec<&'static str>> = LazyLock::new(|| {
+    parameter_table()
+        .iter()
+        .filter(|p| p.runtime)
+        .map(|p| p.name)
+        .collect()
+});
 
 /// A new configuration differs from the running one in a parameter that is not one of
 /// [`RUNTIME_PARAMETERS`].
@@ -40,17 +33,9 @@ pub struct NotRuntimeTunable;
 /// `base` with the values of every runtime parameter taken from `from`.
 fn with_runtime_values(base: &Config, from: &Config) -> Config {
     let mut c = base.clone();
-    c.gnss.elevation_mask_rad = from.gnss.elevation_mask_rad;
-    c.gnss.cn0_mask_dbhz = from.gnss.cn0_mask_dbhz;
-    c.gnss.pseudorange_sigma_m = from.gnss.pseudorange_sigma_m;
-    c.gnss.pseudorange_rate_sigma_mps = from.gnss.pseudorange_rate_sigma_mps;
-    c.gnss.elevation_weighting = from.gnss.elevation_weighting;
-    c.gnss.use_receiver_sigmas = from.gnss.use_receiver_sigmas;
-    c.gnss.innovation_gate_sigma = from.gnss.innovation_gate_sigma;
-    c.gnss.max_clock_jump_m = from.gnss.max_clock_jump_m;
-    c.loose = from.loose.clone();
-    c.engine.max_imu_gap_s = from.engine.max_imu_gap_s;
-    c.output.rate_hz = from.output.rate_hz;
+    for p in parameter_table().iter().filter(|p| p.runtime) {
+        p.take_value(&mut c, from);
+    }
     c
 }
 
@@ -90,7 +75,7 @@ mod tests {
 
     #[test]
     fn every_runtime_parameter_is_taken_over_and_applied() {
-        for key in RUNTIME_PARAMETERS {
+        for key in RUNTIME_PARAMETERS.iter() {
             let mut engine = Engine::new(Config::default());
             let mut changed = engine.config().clone();
             changed

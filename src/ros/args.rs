@@ -1,17 +1,37 @@
-//! The node's command line: the subset of the ROS 2 `--ros-args` syntax it understands,
-//! parsed without side effects (no file is read here).
+//! The node's command line, parsed as rcl parses it and without side effects (no file is
+//! read here).
 //!
-//! Understood after `--ros-args` (which may appear several times; `--` ends a block):
-//! `--params-file FILE`, `-p|--param name:=value`, `-r|--remap from:=to` (topic names,
-//! plus the special `__node:=NAME` and `__ns:=/NS`), `--log-level LEVEL`.
-//! Before `--ros-args`, the node's own argument: `--record OUT.mcap` (write everything the
-//! node publishes to a rosbag2 MCAP bag). Anything else is an error that names the
-//! argument.
+//! After `--ros-args` (which may appear several times; `--` ends a block), in order:
+//! `--params-file FILE` (any number; rcl reads them in order, a later value wins),
+//! `-p|--param [NODE:]name:=value`, `-r|--remap [NODE:]from:=to` (topic names, plus the
+//! special `__node:=NAME` and `__ns:=/NS`), `--log-level [LOGGER:=]LEVEL`. The other
+//! flags rcl knows (`-e|--enclave`, `--log-file-name`, `--log-config-file`,
+//! `--enable-|--disable-{stdout,rosout,external-lib}-logs`) are accepted and ignored with
+//! a warning; any other ROS argument is an error that names it. Before `--ros-args`, the
+//! node's own arguments: `--record OUT.mcap` (write everything the node publishes to a
+//! rosbag2 MCAP bag) and `-h|--help`; a `from:=to` there is a remapping in rcl's
+//! deprecated form (with a warning).
 
 use std::path::PathBuf;
 
-/// The default node name (the params files of `params/` are keyed by it).
+use super::log_level::{LogLevelError, LogLevelRule};
+
+/// The default node name.
 pub const DEFAULT_NODE_NAME: &str = "gnss_ins_node";
+
+/// A `--params-file` or a `-p` rule, in command-line order.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum ParameterSource {
+    /// `--params-file FILE`.
+    File(PathBuf),
+    /// `-p [node:]name:=value`; the value is YAML text. Without a node prefix rcl files
+    /// the rule under `/**`.
+    Rule {
+        node: Option<String>,
+        name: String,
+        value: String,
+    },
+}
 
 /// What the command line asks for.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -20,16 +40,19 @@ pub struct NodeArgs {
     pub node_name: String,
     /// Absolute node namespace (`-r __ns:=/NS`, default `/`).
     pub namespace: String,
-    /// The parameter file (`--params-file`), if any.
-    pub params_file: Option<PathBuf>,
-    /// Parameter overrides (`-p name:=value`) in command-line order; values are YAML text.
-    pub parameters: Vec<(String, String)>,
-    /// Topic remappings (`-r from:=to`) in command-line order.
+    /// Parameter files and `-p` rules in command-line order.
+    pub parameter_sources: Vec<ParameterSource>,
+    /// Topic remappings (`-r from:=to`) in command-line order (those for another node
+    /// left out).
     pub remaps: Vec<(String, String)>,
-    /// `--log-level` value, if given.
-    pub log_level: Option<String>,
+    /// `--log-level` rules in command-line order.
+    pub log_levels: Vec<LogLevelRule>,
     /// `--record OUT.mcap`: the bag that receives every message the node publishes.
     pub record: Option<PathBuf>,
+    /// `-h` / `--help`: print the usage and exit.
+    pub help: bool,
+    /// Arguments accepted but not acted on, each with why: for a warning at start.
+    pub ignored: Vec<String>,
 }
 
 impl Default for NodeArgs {
@@ -37,19 +60,62 @@ impl Default for NodeArgs {
         Self {
             node_name: DEFAULT_NODE_NAME.to_owned(),
             namespace: "/".to_owned(),
-            params_file: None,
-            parameters: Vec::new(),
+            parameter_sources: Vec::new(),
             remaps: Vec::new(),
-            log_level: None,
+            log_levels: Vec::new(),
             record: None,
+            help: false,
+            ignored: Vec::new(),
         }
     }
 }
 
+impl NodeArgs {
+    /// The node's fully qualified name (`/gnss_ins_node`, `/robot/ins`).
+    pub fn fully_qualified_name(&self) -> String {
+        if self.namespace == "/" {
+            format!("/{}", self.node_name)
+        } else {
+            format!("{}/{}", self.namespace, self.node_name)
+        }
+    }
+}
+
+/// The usage text of `gnss_ins_node --help`.
+pub const USAGE: &str = "\
+Usage: gnss_ins_node [--record OUT.mcap] [--ros-args ROS_ARGUMENTS...]
+
+The adaptive GNSS/INS ROS 2 node (speaks DDS itself; honours ROS_DOMAIN_ID and
+RMW_IMPLEMENTATION).
+
+Node arguments:
+  --record OUT.mcap          also write everything the node publishes to a rosbag2 bag
+  -h, --help                 print this text and exit
+
+ROS arguments (after --ros-args, as rcl parses them):
+  --params-file FILE         a ROS 2 parameter file; any number, read in order, a later
+                             value wins (keys: the node name, its fully qualified name,
+                             /**, or wildcards such as /**/gnss_ins_node)
+  -p, --param [NODE:]NAME:=VALUE
+                             one parameter (YAML value), e.g. -p filter.variant:=ermakf
+  -r, --remap [NODE:]FROM:=TO
+                             a topic remapping; __node:=NAME and __ns:=/NS rename the node
+  --log-level [LOGGER:=]LEVEL
+                             debug, info, warn, error or fatal; LOGGER is the node's
+                             logger (its name, e.g. gnss_ins_node) or rustdds/ros2_client
+  -e, --enclave ENCLAVE      accepted and ignored (no DDS security yet)
+
+Example:
+  gnss_ins_node --ros-args --params-file params/ekf.yaml --params-file params/ermakf.yaml \\
+      -r __ns:=/vehicle -r imu:=imu/data -p gnss.elevation_mask_deg:=15.0
+
+Every parameter, its unit, range and default: params/ekf.yaml and docs/parameters.md.
+";
+
 /// A command line the node does not accept.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum ArgsError {
-    #[error("unknown argument `{0}` (the node takes `--record OUT.mcap`, then ROS arguments: --ros-args --params-file FILE, -p name:=value, -r from:=to, -r __node:=NAME, -r __ns:=/NS, --log-level LEVEL)")]
+    #[error("unknown argument `{0}` (the node takes `--record OUT.mcap` and `--help`, then ROS arguments: --ros-args --params-file FILE, -p name:=value, -r from:=to, -r __node:=NAME, -r __ns:=/NS, --log-level LEVEL; see --help)")]
     Unknown(String),
     #[error("`{0}` needs a value")]
     MissingValue(String),
@@ -61,8 +127,10 @@ pub enum ArgsError {
     BadNamespace(String),
     #[error("invalid topic name `{0}` in a remapping")]
     BadTopicName(String),
-    #[error("only one --params-file is supported (got `{first}` and `{second}`)")]
-    SecondParamsFile { first: String, second: String },
+    #[error("`{flag} {value}`: invalid parameter name (name tokens joined by `.`, an optional `NODE:` in front)")]
+    BadParameterName { flag: String, value: String },
+    #[error(transparent)]
+    LogLevel(#[from] LogLevelError),
 }
 
 fn is_token(s: &str) -> bool {
@@ -102,6 +170,66 @@ fn split_assignment(flag: &str, value: &str) -> Result<(String, String), ArgsErr
     }
 }
 
+/// `NODE:rest` → (Some(NODE), rest) when `rest` follows a single name token and a colon
+/// (rcl's node-name prefix of `-p` and `-r` rules); else (None, all).
+fn node_prefix(left: &str) -> (Option<String>, &str) {
+    match left.split_once(':') {
+        Some((node, rest)) if is_token(node) && !rest.is_empty() => (Some(node.to_owned()), rest),
+        _ => (None, left),
+    }
+}
+
+/// A `-p` rule: `[node:]name:=value` with `name` made of name tokens joined by dots.
+fn parameter_rule(flag: &str, text: &str) -> Result<ParameterSource, ArgsError> {
+    let (left, value) = split_assignment(flag, text)?;
+    let (node, name) = node_prefix(&left);
+    if !name.split('.').all(is_token) {
+        return Err(ArgsError::BadParameterName {
+            flag: flag.to_owned(),
+            value: text.to_owned(),
+        });
+    }
+    Ok(ParameterSource::Rule {
+        node,
+        name: name.to_owned(),
+        value,
+    })
+}
+
+/// Flags rcl knows that this node accepts and ignores: (flag, takes a value, why).
+const IGNORED_FLAGS: [(&str, bool, &str); 10] = [
+    ("--enclave", true, "no DDS security yet"),
+    ("-e", true, "no DDS security yet"),
+    (
+        "--log-file-name",
+        true,
+        "the node logs to stderr and /rosout only",
+    ),
+    (
+        "--log-config-file",
+        true,
+        "the node logs to stderr and /rosout only",
+    ),
+    ("--enable-stdout-logs", false, "stderr logging is always on"),
+    (
+        "--disable-stdout-logs",
+        false,
+        "stderr logging is always on",
+    ),
+    ("--enable-rosout-logs", false, "/rosout is always on"),
+    ("--disable-rosout-logs", false, "/rosout is always on"),
+    (
+        "--enable-external-lib-logs",
+        false,
+        "there is no external log library",
+    ),
+    (
+        "--disable-external-lib-logs",
+        false,
+        "there is no external log library",
+    ),
+];
+
 /// Parses the arguments after the program name.
 pub fn parse<I, S>(args: I) -> Result<NodeArgs, ArgsError>
 where
@@ -109,6 +237,8 @@ where
     S: Into<String>,
 {
     let mut out = NodeArgs::default();
+    // Remappings with their node prefix, filtered once the node name is known.
+    let mut remaps: Vec<(Option<String>, String, String)> = Vec::new();
     let mut in_ros_args = false;
     let mut it = args.into_iter().map(Into::into);
     while let Some(arg) = it.next() {
@@ -117,80 +247,135 @@ where
             continue;
         }
         if !in_ros_args {
-            if arg == "--record" && out.record.is_none() {
-                let file = it.next().ok_or(ArgsError::MissingValue(arg))?;
-                out.record = Some(PathBuf::from(file));
-                continue;
+            match arg.as_str() {
+                "--record" if out.record.is_none() => {
+                    let file = it.next().ok_or(ArgsError::MissingValue(arg))?;
+                    out.record = Some(PathBuf::from(file));
+                }
+                "-h" | "--help" => out.help = true,
+                // rcl's deprecated form of a remapping, outside --ros-args.
+                _ if arg.contains(":=") => {
+                    out.ignored.push(format!(
+                        "`{arg}`: a remapping outside --ros-args is deprecated; use \
+                         --ros-args -r {arg}"
+                    ));
+                    let (from, to) = split_assignment("-r", &arg)?;
+                    let (node, from) = node_prefix(&from);
+                    remaps.push((node, from.to_owned(), to));
+                }
+                _ => return Err(ArgsError::Unknown(arg)),
             }
-            return Err(ArgsError::Unknown(arg));
+            continue;
         }
         let mut value_of = |flag: &str| it.next().ok_or(ArgsError::MissingValue(flag.to_owned()));
         match arg.as_str() {
             "--" => in_ros_args = false,
             "--params-file" => {
                 let file = value_of(&arg)?;
-                if let Some(first) = &out.params_file {
-                    return Err(ArgsError::SecondParamsFile {
-                        first: first.display().to_string(),
-                        second: file,
-                    });
-                }
-                out.params_file = Some(PathBuf::from(file));
+                out.parameter_sources
+                    .push(ParameterSource::File(PathBuf::from(file)));
             }
             "-p" | "--param" => {
                 let v = value_of(&arg)?;
-                out.parameters.push(split_assignment(&arg, &v)?);
+                out.parameter_sources.push(parameter_rule(&arg, &v)?);
             }
             "-r" | "--remap" => {
                 let v = value_of(&arg)?;
                 let (from, to) = split_assignment(&arg, &v)?;
-                match from.as_str() {
-                    "__node" | "__name" => {
-                        if !is_valid_node_name(&to) {
-                            return Err(ArgsError::BadNodeName(to));
-                        }
-                        out.node_name = to;
-                    }
-                    "__ns" => {
-                        if !is_valid_namespace(&to) {
-                            return Err(ArgsError::BadNamespace(to));
-                        }
-                        out.namespace = to;
-                    }
-                    _ => {
-                        for name in [&from, &to] {
-                            if !is_valid_topic_name(name) {
-                                return Err(ArgsError::BadTopicName(name.clone()));
-                            }
-                        }
-                        out.remaps.push((from, to));
-                    }
-                }
+                let (node, from) = node_prefix(&from);
+                remaps.push((node, from.to_owned(), to));
             }
-            "--log-level" => out.log_level = Some(value_of(&arg)?),
-            _ => return Err(ArgsError::Unknown(arg)),
+            "--log-level" => {
+                let v = value_of(&arg)?;
+                out.log_levels.push(LogLevelRule::parse(&v)?);
+            }
+            flag => match IGNORED_FLAGS.iter().find(|(f, _, _)| *f == flag) {
+                Some((_, takes_value, why)) => {
+                    let shown = if *takes_value {
+                        format!("{flag} {}", value_of(flag)?)
+                    } else {
+                        flag.to_owned()
+                    };
+                    out.ignored.push(format!("`{shown}` is ignored: {why}"));
+                }
+                None => return Err(ArgsError::Unknown(arg)),
+            },
         }
     }
+    resolve_remaps(&mut out, remaps)?;
     Ok(out)
 }
 
-/// True when a params file's top-level key `key` addresses the node `name` in namespace
-/// `ns`: `/**`, the base name, or the fully qualified name (with or without leading `/`).
-pub fn params_key_matches(key: &str, ns: &str, name: &str) -> bool {
-    let fully_qualified = if ns == "/" {
-        format!("/{name}")
-    } else {
-        format!("{ns}/{name}")
-    };
-    key == "/**" || key == name || key == fully_qualified || Some(key) == fully_qualified.get(1..)
+/// Applies the remapping rules as rcl does: every rule is checked; the first `__node`
+/// (`__name`) and the first `__ns` rule for this node rename it (a `NODE:` prefix must
+/// name the node as it is called without renaming); topic rules are kept in order (the
+/// first that matches a name wins), those with a prefix only when it is the node's name.
+fn resolve_remaps(
+    out: &mut NodeArgs,
+    rules: Vec<(Option<String>, String, String)>,
+) -> Result<(), ArgsError> {
+    let original_name = out.node_name.clone();
+    let mut renamed = false;
+    let mut moved = false;
+    let mut topics = Vec::new();
+    for (node, from, to) in rules {
+        let for_original = node.as_ref().is_none_or(|n| *n == original_name);
+        match from.as_str() {
+            "__node" | "__name" => {
+                if !is_valid_node_name(&to) {
+                    return Err(ArgsError::BadNodeName(to));
+                }
+                if for_original && !renamed {
+                    out.node_name = to;
+                    renamed = true;
+                }
+            }
+            "__ns" => {
+                if !is_valid_namespace(&to) {
+                    return Err(ArgsError::BadNamespace(to));
+                }
+                if for_original && !moved {
+                    out.namespace = to;
+                    moved = true;
+                }
+            }
+            _ => {
+                for name in [&from, &to] {
+                    if !is_valid_topic_name(name) {
+                        return Err(ArgsError::BadTopicName(name.clone()));
+                    }
+                }
+                topics.push((node, from, to));
+            }
+        }
+    }
+    out.remaps = topics
+        .into_iter()
+        .filter(|(node, _, _)| node.as_ref().is_none_or(|n| *n == out.node_name))
+        .map(|(_, from, to)| (from, to))
+        .collect();
+    Ok(())
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::ros::log_level::Severity;
 
     fn p(args: &[&str]) -> Result<NodeArgs, ArgsError> {
         parse(args.iter().copied())
+    }
+
+    fn rule(node: Option<&str>, name: &str, value: &str) -> ParameterSource {
+        ParameterSource::Rule {
+            node: node.map(str::to_owned),
+            name: name.to_owned(),
+            value: value.to_owned(),
+        }
+    }
+
+    fn file(path: &str) -> ParameterSource {
+        ParameterSource::File(PathBuf::from(path))
     }
 
     #[test]
@@ -207,6 +392,8 @@ mod tests {
             "params/ekf.yaml",
             "-p",
             "imu.gyro_bias_deg_per_h:=0.3",
+            "--params-file",
+            "params/ermakf.yaml",
             "--param",
             "filter.variant:=ermakf",
             "-r",
@@ -218,25 +405,56 @@ mod tests {
             "__ns:=/robot1",
             "--log-level",
             "debug",
+            "--log-level",
+            "robot1.ins:=WARN",
             "--",
         ])
         .unwrap();
-        assert_eq!(a.params_file, Some(PathBuf::from("params/ekf.yaml")));
         assert_eq!(
-            a.parameters,
+            a.parameter_sources,
             vec![
-                ("imu.gyro_bias_deg_per_h".into(), "0.3".into()),
-                ("filter.variant".into(), "ermakf".into())
+                file("params/ekf.yaml"),
+                rule(None, "imu.gyro_bias_deg_per_h", "0.3"),
+                file("params/ermakf.yaml"),
+                rule(None, "filter.variant", "ermakf"),
             ]
         );
         assert_eq!(a.remaps, vec![("imu".into(), "/sensors/imu".into())]);
         assert_eq!(a.node_name, "ins");
         assert_eq!(a.namespace, "/robot1");
-        assert_eq!(a.log_level.as_deref(), Some("debug"));
+        assert_eq!(a.fully_qualified_name(), "/robot1/ins");
+        assert_eq!(a.log_levels.len(), 2);
+        assert_eq!(a.log_levels[1].logger.as_deref(), Some("robot1.ins"));
+        assert_eq!(a.log_levels[1].level, Severity::Warn);
     }
 
     #[test]
-    fn record_comes_before_the_ros_args() {
+    fn node_prefixes_address_one_node() {
+        let a = p(&[
+            "--ros-args",
+            "-p",
+            "gnss_ins_node:filter.variant:=iarf",
+            "-r",
+            "other:imu:=/x",
+            "-r",
+            "gnss_ins_node:gnss/fix:=/y",
+            "-r",
+            "other:__node:=z",
+        ])
+        .unwrap();
+        assert_eq!(
+            a.parameter_sources,
+            vec![rule(Some("gnss_ins_node"), "filter.variant", "iarf")]
+        );
+        assert_eq!(a.remaps, vec![("gnss/fix".into(), "/y".into())]);
+        assert_eq!(a.node_name, DEFAULT_NODE_NAME);
+        // As in rcl, the first rename rule wins.
+        let a = p(&["--ros-args", "-r", "__node:=a", "-r", "__node:=b"]).unwrap();
+        assert_eq!(a.node_name, "a");
+    }
+
+    #[test]
+    fn record_and_help_come_before_the_ros_args() {
         let a = p(&["--record", "out.mcap", "--ros-args", "-r", "__node:=ins"]).unwrap();
         assert_eq!(a.record, Some(PathBuf::from("out.mcap")));
         assert_eq!(
@@ -246,12 +464,19 @@ mod tests {
         // Once only, and not inside the ROS block.
         assert!(p(&["--record", "a.mcap", "--record", "b.mcap"]).is_err());
         assert!(p(&["--ros-args", "--record", "a.mcap"]).is_err());
+        assert!(p(&["--help"]).unwrap().help && p(&["-h"]).unwrap().help);
+        assert!(USAGE.contains("--params-file") && USAGE.contains("--log-level"));
     }
 
     #[test]
     fn value_may_contain_assignment_sign() {
         let a = p(&["--ros-args", "-p", "output.datum_llh_deg_m:=[1, 2, 3]"]).unwrap();
-        assert_eq!(a.parameters[0].1, "[1, 2, 3]");
+        assert_eq!(
+            a.parameter_sources,
+            vec![rule(None, "output.datum_llh_deg_m", "[1, 2, 3]")]
+        );
+        let a = p(&["--ros-args", "-p", "a:=x:=y"]).unwrap();
+        assert_eq!(a.parameter_sources, vec![rule(None, "a", "x:=y")]);
     }
 
     #[test]
@@ -261,8 +486,8 @@ mod tests {
             Err(ArgsError::Unknown("--verbose".into()))
         );
         assert_eq!(
-            p(&["--ros-args", "--enclave", "x"]),
-            Err(ArgsError::Unknown("--enclave".into()))
+            p(&["--ros-args", "--bogus"]),
+            Err(ArgsError::Unknown("--bogus".into()))
         );
         // After `--` the ROS block is closed: a plain argument is not ours either.
         assert_eq!(
@@ -274,6 +499,35 @@ mod tests {
             msg.contains("--verbose") && msg.contains("--params-file"),
             "{msg}"
         );
+    }
+
+    #[test]
+    fn flags_rcl_knows_are_accepted_with_a_warning() {
+        let a = p(&[
+            "--ros-args",
+            "--enclave",
+            "/secure",
+            "-e",
+            "/x",
+            "--disable-rosout-logs",
+            "--log-file-name",
+            "f",
+        ])
+        .unwrap();
+        assert_eq!(a.ignored.len(), 4, "{:?}", a.ignored);
+        assert!(
+            a.ignored[0].contains("--enclave /secure"),
+            "{:?}",
+            a.ignored
+        );
+        assert_eq!(
+            p(&["--ros-args", "--enclave"]),
+            Err(ArgsError::MissingValue("--enclave".into()))
+        );
+        // rcl's deprecated remapping outside --ros-args.
+        let a = p(&["imu:=/sensors/imu"]).unwrap();
+        assert_eq!(a.remaps, vec![("imu".into(), "/sensors/imu".into())]);
+        assert!(a.ignored[0].contains("deprecated"), "{:?}", a.ignored);
     }
 
     #[test]
@@ -290,6 +544,10 @@ mod tests {
             p(&["--ros-args", "-p", ":=3"]),
             Err(ArgsError::NotAssignment { .. })
         ));
+        assert!(matches!(
+            p(&["--ros-args", "-p", "filter..variant:=ekf"]),
+            Err(ArgsError::BadParameterName { .. })
+        ));
         assert_eq!(
             p(&["--ros-args", "-r", "__ns:=robot"]),
             Err(ArgsError::BadNamespace("robot".into()))
@@ -303,20 +561,8 @@ mod tests {
             Err(ArgsError::BadTopicName("a//b".into()))
         );
         assert!(matches!(
-            p(&["--ros-args", "--params-file", "a", "--params-file", "b"]),
-            Err(ArgsError::SecondParamsFile { .. })
+            p(&["--ros-args", "--log-level", "loud"]),
+            Err(ArgsError::LogLevel(_))
         ));
-    }
-
-    #[test]
-    fn params_file_keys() {
-        assert!(params_key_matches("/**", "/", "gnss_ins_node"));
-        assert!(params_key_matches("gnss_ins_node", "/", "gnss_ins_node"));
-        assert!(params_key_matches("/gnss_ins_node", "/", "gnss_ins_node"));
-        assert!(params_key_matches("/r1/ins", "/r1", "ins"));
-        assert!(params_key_matches("r1/ins", "/r1", "ins"));
-        assert!(!params_key_matches("gnss_ins_node", "/", "ins"));
-        assert!(!params_key_matches("/r2/ins", "/r1", "ins"));
-        assert!(!params_key_matches("/*", "/", "ins"));
     }
 }

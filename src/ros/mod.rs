@@ -9,7 +9,9 @@
 //! - [`fix_velocity`]: `gnss/fix` joined with its `gnss/velocity` (node and replay).
 //! - [`outbound`]: engine outputs -> Odometry, NavSatFix, NoiseEstimates.
 //! - [`bag`]: rosbag2-compatible MCAP bag writing and streaming reading.
-//! - [`args`]: the node's `--ros-args` command line; [`names`]: topic-name resolution.
+//! - [`args`]: the node's `--ros-args` command line; [`log_level`]: its `--log-level`
+//!   rules; [`param_overrides`]: its parameter files and `-p` rules resolved as rclcpp
+//!   does; [`names`]: topic-name resolution.
 //! - [`node`]: the `gnss_ins_node` ROS 2 node (ros2-client) around the engine.
 //! - [`player`]: `gnss_ins play`, a recorded bag published onto DDS.
 
@@ -18,8 +20,10 @@ pub mod bag;
 pub mod cdr;
 pub mod convert;
 pub mod fix_velocity;
+pub mod log_level;
 pub mod msg;
 pub mod names;
 pub mod node;
 pub mod outbound;
+pub mod param_overrides;
 pub mod player;

@@ -42,9 +42,11 @@ pub enum Command {
     /// Stream a bag through the engine; write the solution; score it against a reference.
     Replay {
         bag: PathBuf,
-        /// Parameter file (ROS 2 params layout); defaults when absent.
+        /// Parameter file (ROS 2 params layout, as the node reads it); repeat it to load
+        /// a preset over the manual, e.g. --params params/ekf.yaml --params
+        /// params/ermakf.yaml (a later value wins). Defaults when absent.
         #[arg(long)]
-        params: Option<PathBuf>,
+        params: Vec<PathBuf>,
         /// Output bag with /odometry, /fix and /noise_estimates.
         #[arg(long)]
         out: Option<PathBuf>,
@@ -65,13 +67,15 @@ pub enum Command {
         /// Comma-separated variants (e.g. ekf,ermakf); all when absent.
         #[arg(long, value_delimiter = ',')]
         filters: Vec<String>,
-        /// Folder of parameter files named <variant>.yaml (else the defaults).
-        #[arg(long, conflicts_with = "params")]
-        params_dir: Option<PathBuf>,
-        /// One parameter file (e.g. a sensor description) for every variant, its
-        /// filter.variant replaced by each variant in turn.
+        /// Folder of parameter files named <variant>.yaml, each loaded after the --params
+        /// files for its variant (e.g. --params-dir params: the presets).
         #[arg(long)]
-        params: Option<PathBuf>,
+        params_dir: Option<PathBuf>,
+        /// Parameter file (e.g. a sensor description) for every variant, its
+        /// filter.variant replaced by each variant in turn (unless its <variant>.yaml of
+        /// --params-dir sets it); repeatable, a later value wins.
+        #[arg(long)]
+        params: Vec<PathBuf>,
         /// Also tabulate the errors by environment (simulated segments, or the reference's
         /// solution quality in a converted bag: rtk_fixed, rtk_float).
         #[arg(long)]
@@ -141,7 +145,7 @@ pub fn run(command: Command) -> Result<(), String> {
             truth_topic,
             truth_csv,
         } => {
-            let config = load_config(params.as_deref())?;
+            let config = load_config(&params)?;
             let truth = match (truth_topic, truth_csv) {
                 (Some(t), _) => TruthSource::Topic(t),
                 (None, Some(path)) => {
@@ -214,11 +218,7 @@ pub fn run(command: Command) -> Result<(), String> {
             format,
             plots,
         } => {
-            let base = match &params {
-                Some(p) => Some(load_config(Some(p))?),
-                None => None,
-            };
-            let runs = compare_bag(&bag, &filters, params_dir.as_deref(), base.as_ref())?;
+            let runs = compare_bag(&bag, &filters, params_dir.as_deref(), &params)?;
             let rows: Vec<ComparisonRow> = runs.iter().map(|(row, _)| row.clone()).collect();
             print!("{}", render(&rows, format)?);
             if by_environment {
@@ -263,7 +263,7 @@ pub fn run(command: Command) -> Result<(), String> {
                 bag.display(),
                 scenario.duration_s()
             );
-            let runs = compare_bag(&bag, &[], None, None)?;
+            let runs = compare_bag(&bag, &[], None, &[])?;
             let rows: Vec<ComparisonRow> = runs.into_iter().map(|(row, _)| row).collect();
             print!("{}", format_table(&rows));
             Ok(())
@@ -325,27 +325,25 @@ fn load_scenario(name_or_file: &str, seed: u64) -> Result<Scenario, String> {
     Scenario::new(spec, seed).map_err(|e| e.to_string())
 }
 
-pub(super) fn load_config(path: Option<&Path>) -> Result<Config, String> {
-    match path {
-        None => Ok(Config::default()),
-        Some(p) => {
-            let text = std::fs::read_to_string(p).map_err(|e| format!("{}: {e}", p.display()))?;
-            Config::from_yaml_str(&text, &p.display().to_string()).map_err(|e| e.to_string())
-        }
-    }
+/// The configuration of parameter files read in order as the node reads them (a later
+/// value wins; the node's own parameters are ignored); the defaults without any.
+pub(super) fn load_config(paths: &[PathBuf]) -> Result<Config, String> {
+    crate::ros::node::params::config_from_files(paths).map_err(|e| e.to_string())
 }
 
-/// The configuration of one variant: `<dir>/<variant>.yaml` when present, else `base`
-/// (or the defaults) with that variant.
+/// The configuration of one variant: the `base` files, then `<dir>/<variant>.yaml` when
+/// present; without it, the `base` files with that variant.
 fn variant_config(
     name: &str,
     params_dir: Option<&Path>,
-    base: Option<&Config>,
+    base: &[PathBuf],
 ) -> Result<Config, String> {
     if let Some(dir) = params_dir {
         let path = dir.join(format!("{name}.yaml"));
         if path.exists() {
-            return load_config(Some(&path));
+            let mut files = base.to_vec();
+            files.push(path);
+            return load_config(&files);
         }
     }
     let variant = FilterVariant::ALL
@@ -355,7 +353,7 @@ fn variant_config(
             let known: Vec<&str> = FilterVariant::ALL.iter().map(|v| v.as_str()).collect();
             format!("unknown filter '{name}' (known: {})", known.join(", "))
         })?;
-    let mut config = base.cloned().unwrap_or_default();
+    let mut config = load_config(base)?;
     config.filter.variant = variant;
     Ok(config)
 }
@@ -365,7 +363,7 @@ fn compare_bag(
     bag: &Path,
     filters: &[String],
     params_dir: Option<&Path>,
-    base: Option<&Config>,
+    base: &[PathBuf],
 ) -> Result<Vec<(ComparisonRow, SessionReport)>, String> {
     let names: Vec<String> = if filters.is_empty() {
         FilterVariant::ALL

@@ -226,9 +226,10 @@ pub struct SppArgs {
     /// A bag with GNSS measurements (and a reference on /ground_truth), or a UBX log
     /// (name ending in .ubx), converted on the fly.
     pub input: PathBuf,
-    /// Parameter file whose gnss.* settings (mask, σ model, constellations) are used.
+    /// Parameter file whose gnss.* settings (mask, σ model, constellations) are used;
+    /// repeatable as for `replay` (a later value wins).
     #[arg(long)]
-    pub params: Option<PathBuf>,
+    pub params: Vec<PathBuf>,
     /// With a UBX log: its reference and time scale (as for `convert`).
     #[command(flatten)]
     pub reference: ReferenceArgs,
@@ -285,7 +286,7 @@ pub fn convert(args: ConvertArgs) -> Result<(), String> {
 
 /// `gnss_ins spp`.
 pub fn spp(args: SppArgs) -> Result<(), String> {
-    let config = load_config(args.params.as_deref())?;
+    let config = load_config(&args.params)?;
     let is_ubx = args
         .input
         .extension()

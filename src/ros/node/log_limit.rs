@@ -24,6 +24,25 @@ impl LogLimiter {
     }
 }
 
+#[cfg(test)]
+impl LogLimiter {
+    /// How many `kind` warnings were counted.
+    pub fn count(&self, kind: &str) -> u64 {
+        self.counts.get(kind).copied().unwrap_or(0)
+    }
+
+    /// How many `kind` warnings were logged: one per power of ten up to the count.
+    pub fn logged(&self, kind: &str) -> u64 {
+        let mut n = self.count(kind);
+        let mut powers = 0;
+        while n > 0 {
+            n /= 10;
+            powers += 1;
+        }
+        powers
+    }
+}
+
 fn is_power_of_ten(mut n: u64) -> bool {
     while n >= 10 && n % 10 == 0 {
         n /= 10;

@@ -12,7 +12,6 @@ pub mod clock;
 pub mod handler;
 pub mod input_stats;
 pub mod log_limit;
-mod param_docs;
 pub mod param_server;
 pub mod params;
 pub mod recorder;

@@ -4,14 +4,20 @@
 //!
 //! The parameters are the core configuration's (`section.key`, human units, the names of
 //! the parameter file) plus the node's own `use_sim_time`, `map_frame`, `base_frame`,
-//! `publish_tf` and `queue_depth`. A set request is validated like the parameter file; only
-//! [`RUNTIME_PARAMETERS`] (and `use_sim_time`) are accepted while the node runs, every
-//! other parameter is read-only and a set is refused with the reason.
+//! `publish_tf` and `queue_depth`; their descriptions, ranges and read-only flags come
+//! from the parameter table and [`NODE_PARAMETERS`]. A set request is validated like the
+//! parameter file; only the run-time parameters (and `use_sim_time`) are accepted while
+//! the node runs, every other parameter is read-only and a set is refused with the reason.
+//!
+//! Requests are bounded (issue 12): names and values longer than a parameter can be are
+//! refused without being echoed, refusals are logged rate-limited, and a reply whose
+//! payload would exceed [`MAX_REPLY_BYTES`] is cut down before it is sent.
 
-use std::collections::{BTreeSet, HashMap};
+use std::collections::BTreeSet;
 
 use ros2_client::parameters::raw::{
-    Parameter, ParameterDescriptor, ParameterType, ParameterValue, SetParametersResult,
+    FloatingPointRange, IntegerRange, Parameter, ParameterDescriptor, ParameterType,
+    ParameterValue, SetParametersResult,
 };
 use ros2_client::rcl_interfaces::{
     DescribeParametersResponse, GetParameterTypesResponse, GetParametersResponse,
@@ -20,12 +26,13 @@ use ros2_client::rcl_interfaces::{
 };
 use serde_yaml::Value;
 
-use crate::config::Config;
-use crate::engine::RUNTIME_PARAMETERS;
+use crate::config::{self, Config, ConfigError, Kind};
+use crate::ros::cdr;
 
-use super::param_docs;
+use super::log_limit::LogLimiter;
 use super::params::{
-    OutputFrames, BASE_FRAME, DEFAULT_QUEUE_DEPTH, MAP_FRAME, PUBLISH_TF, QUEUE_DEPTH, USE_SIM_TIME,
+    NodeParameter, OutputFrames, BASE_FRAME, DEFAULT_QUEUE_DEPTH, MAP_FRAME, PUBLISH_TF,
+    QUEUE_DEPTH, USE_SIM_TIME,
 };
 use super::NodeCore;
 
@@ -33,38 +40,36 @@ use super::NodeCore;
 const DEPTH_RECURSIVE: u64 = 0;
 const SEPARATOR: char = '.';
 
-/// The parameter services' state: the descriptions and the node-level parameters.
-#[derive(Debug, Clone)]
+/// Longest parameter name accepted in a request (bytes); a longer one is refused
+/// without being echoed.
+///
+/// Choice: 256, six times the longest name of the table.
+pub const MAX_NAME_BYTES: usize = 256;
+/// Most names (or parameters) in one request; the rest of a longer request is not
+/// answered.
+///
+/// Choice: 256, about three times as many as the node has parameters.
+pub const MAX_NAMES: usize = 256;
+/// Longest string, and most elements of a list, in a value to set.
+///
+/// Choice: 1024; the longest value of the node is a list of six constellation names.
+pub const MAX_VALUE_LEN: usize = 1024;
+/// Largest reply payload (bytes of CDR).
+///
+/// Choice: 32 KiB. A reply larger than a UDP datagram (about 64 KB) never reaches a
+/// Cyclone DDS client (issue 12), and the describe reply of every parameter takes about
+/// half of this budget.
+pub const MAX_REPLY_BYTES: usize = 32 * 1024;
+
+/// The parameter services' state: the node-level parameters and the rate limit of the
+/// refusals' log lines.
+#[derive(Debug)]
 pub struct ParameterServer {
-    descriptions: HashMap<String, String>,
     use_sim_time: bool,
     frames: OutputFrames,
     queue_depth: usize,
+    log: LogLimiter,
 }
-
-/// Descriptions of the node's own parameters (the core's come from the manual).
-const NODE_DESCRIPTIONS: [(&str, &str); 5] = [
-    (
-        USE_SIM_TIME,
-        "The node's time (diagnostics and rosout stamps, input ages) follows /clock.",
-    ),
-    (
-        MAP_FRAME,
-        "Parent frame of odometry and /tf: ENU at the datum (REP-105 map). Read-only.",
-    ),
-    (
-        BASE_FRAME,
-        "Child frame of odometry and /tf, frame of fix: the vehicle body (FLU). Read-only.",
-    ),
-    (
-        PUBLISH_TF,
-        "Publish map_frame -> base_frame on /tf with each odometry. Read-only.",
-    ),
-    (
-        QUEUE_DEPTH,
-        "History depth (messages) of the input subscriptions and the publishers. Read-only.",
-    ),
-];
 
 fn value(ptype: u8) -> ParameterValue {
     ParameterValue {
@@ -206,15 +211,11 @@ fn listed(name: &str, prefixes: &[String], depth: u64) -> bool {
 impl ParameterServer {
     /// Services starting with the node parameters as given on the command line.
     pub fn new(use_sim_time: bool, frames: OutputFrames) -> Self {
-        let mut descriptions = param_docs::descriptions();
-        for (name, text) in NODE_DESCRIPTIONS {
-            descriptions.insert(name.to_owned(), text.to_owned());
-        }
         Self {
-            descriptions,
             use_sim_time,
             frames,
             queue_depth: DEFAULT_QUEUE_DEPTH,
+            log: LogLimiter::default(),
         }
     }
 
@@ -252,19 +253,23 @@ impl ParameterServer {
     }
 
     fn lookup(&self, config: &Config, name: &str) -> Option<ParameterValue> {
+        if name.len() > MAX_NAME_BYTES {
+            return None;
+        }
         self.all(config)
             .into_iter()
             .find(|(n, _)| n == name)
             .map(|(_, v)| v)
     }
 
-    /// `list_parameters`.
+    /// `list_parameters` (the answer holds only the node's own names, so it is bounded).
     pub fn list(&self, config: &Config, req: &ListParametersRequest) -> ListParametersResponse {
+        let prefixes = &req.prefixes[..req.prefixes.len().min(MAX_NAMES)];
         let names: Vec<String> = self
             .all(config)
             .into_iter()
             .map(|(n, _)| n)
-            .filter(|n| listed(n, &req.prefixes, req.depth))
+            .filter(|n| listed(n, prefixes, req.depth))
             .collect();
         let prefixes: BTreeSet<String> = names
             .iter()
@@ -279,8 +284,9 @@ impl ParameterServer {
     }
 
     /// `get_parameters`: one value per name, NOT_SET for an unknown name.
-    pub fn get(&self, config: &Config, names: &[String]) -> GetParametersResponse {
-        GetParametersResponse {
+    pub fn get(&mut self, config: &Config, names: &[String]) -> GetParametersResponse {
+        let names = self.bounded_names(names, "get_parameters");
+        let mut response = GetParametersResponse {
             values: names
                 .iter()
                 .map(|n| {
@@ -288,11 +294,15 @@ impl ParameterServer {
                         .unwrap_or_else(|| value(ParameterType::NOT_SET))
                 })
                 .collect(),
-        }
+        };
+        self.fit("get_parameters", &mut response, |r| {
+            r.values.pop().is_some()
+        });
+        response
     }
 
     /// `get_parameter_types`: one type per name, NOT_SET for an unknown name.
-    pub fn types(&self, config: &Config, names: &[String]) -> GetParameterTypesResponse {
+    pub fn types(&mut self, config: &Config, names: &[String]) -> GetParameterTypesResponse {
         GetParameterTypesResponse {
             values: self
                 .get(config, names)
@@ -303,32 +313,105 @@ impl ParameterServer {
         }
     }
 
-    /// `describe_parameters`: type, description from the manual, and read-only for every
-    /// parameter that cannot change while the node runs.
-    pub fn describe(&self, config: &Config, names: &[String]) -> DescribeParametersResponse {
+    /// `describe_parameters`: type, description, range and read-only flag from the
+    /// parameter table (or the node's own declarations).
+    pub fn describe(&mut self, config: &Config, names: &[String]) -> DescribeParametersResponse {
+        let names = self.bounded_names(names, "describe_parameters");
         let values = names
             .iter()
-            .map(|name| {
-                let known = self.lookup(config, name);
-                let runtime = name == USE_SIM_TIME || RUNTIME_PARAMETERS.contains(&name.as_str());
-                ParameterDescriptor {
-                    name: name.clone(),
-                    r#type: known.as_ref().map_or(ParameterType::NOT_SET, |v| v.ptype),
-                    description: self.descriptions.get(name).cloned().unwrap_or_default(),
-                    additional_constraints: if known.is_none() || runtime {
-                        String::new()
-                    } else {
-                        "read-only while the node runs: set it in the parameter file or with -p"
-                            .to_owned()
-                    },
-                    read_only: known.is_some() && !runtime,
-                    dynamic_typing: false,
-                    floating_point_range: Vec::new(),
-                    integer_range: Vec::new(),
-                }
-            })
+            .map(|name| self.descriptor(config, name))
             .collect();
-        DescribeParametersResponse { values }
+        let mut response = DescribeParametersResponse { values };
+        self.fit("describe_parameters", &mut response, |r| {
+            r.values.pop().is_some()
+        });
+        response
+    }
+
+    fn descriptor(&self, config: &Config, name: &str) -> ParameterDescriptor {
+        let known = self.lookup(config, name);
+        let core = config::parameter(name);
+        let node = NodeParameter::named(name);
+        let runtime = core.map(|p| p.runtime).or(node.map(|p| p.runtime));
+        let range = core.and_then(|p| p.range.closed_bounds());
+        let (floating_point_range, integer_range) = match (range, core.map(|p| p.kind)) {
+            (Some((from_value, to_value)), Some(Kind::Double)) => (
+                vec![FloatingPointRange {
+                    from_value,
+                    to_value,
+                    step: 0.0,
+                }],
+                Vec::new(),
+            ),
+            (Some((from, to)), Some(Kind::Integer)) => (
+                Vec::new(),
+                vec![IntegerRange {
+                    from_value: from as i64,
+                    to_value: to as i64,
+                    step: 0,
+                }],
+            ),
+            _ => (Vec::new(), Vec::new()),
+        };
+        ParameterDescriptor {
+            // An over-long unknown name is not echoed.
+            name: ConfigError::shortened(name),
+            r#type: known.as_ref().map_or(ParameterType::NOT_SET, |v| v.ptype),
+            description: core
+                .map(|p| p.description())
+                .or(node.map(|p| p.description()))
+                .unwrap_or_default(),
+            additional_constraints: match runtime {
+                Some(false) => {
+                    "read-only while the node runs: set it in the parameter file or with -p"
+                        .to_owned()
+                }
+                _ => String::new(),
+            },
+            read_only: runtime == Some(false),
+            dynamic_typing: false,
+            floating_point_range,
+            integer_range,
+        }
+    }
+
+    /// The first [`MAX_NAMES`] of `names` (a longer request is logged, rate-limited).
+    fn bounded_names<'a>(&mut self, names: &'a [String], service: &str) -> &'a [String] {
+        if names.len() > MAX_NAMES {
+            self.refused(
+                service,
+                &format!(
+                    "{service}: a request for {} names, only the first {MAX_NAMES} answered",
+                    names.len()
+                ),
+            );
+        }
+        &names[..names.len().min(MAX_NAMES)]
+    }
+
+    /// Drops entries from the end of `response` (with `pop`) until its payload fits
+    /// [`MAX_REPLY_BYTES`].
+    fn fit<R: serde::Serialize>(
+        &mut self,
+        service: &str,
+        response: &mut R,
+        pop: impl Fn(&mut R) -> bool,
+    ) {
+        let size = |r: &R| cdr::encode(r).map_or(usize::MAX, |b| b.len());
+        if size(response) <= MAX_REPLY_BYTES {
+            return;
+        }
+        while size(response) > MAX_REPLY_BYTES && pop(response) {}
+        self.refused(
+            service,
+            &format!("{service}: reply cut to {MAX_REPLY_BYTES} bytes"),
+        );
+    }
+
+    /// Logs a refusal, rate-limited per kind (issue 12: a flood of bad requests must not
+    /// flood stderr and /rosout).
+    fn refused(&mut self, kind: &str, message: &str) {
+        self.log.warn(kind, message);
     }
 
     /// The configuration after setting `param` on `config` (validated as the file is);
@@ -337,7 +420,7 @@ impl ParameterServer {
         let name = &param.name;
         let current = self
             .lookup(config, name)
-            .ok_or_else(|| format!("no parameter `{name}`"))?;
+            .ok_or_else(|| format!("no parameter `{}`", ConfigError::shortened(name)))?;
         if name == QUEUE_DEPTH {
             return Err(format!(
                 "`{name}` is read-only while the node runs (the DDS entities are created \
@@ -350,7 +433,7 @@ impl ParameterServer {
                  fixed frames): restart the node with -p {name}:=VALUE or a parameter file"
             ));
         }
-        if !RUNTIME_PARAMETERS.contains(&name.as_str()) {
+        if !config::parameter(name).is_some_and(|p| p.runtime) {
             return Err(format!(
                 "`{name}` is read-only while the node runs (the filter is built from it at \
                  start): restart the node with -p {name}:=VALUE or a parameter file"
@@ -375,6 +458,7 @@ impl ParameterServer {
     }
 
     fn set_one(&mut self, core: &mut NodeCore, param: &Parameter) -> Result<(), String> {
+        oversized(param)?;
         if param.name == USE_SIM_TIME {
             self.use_sim_time = Self::sim_time_value(param)?;
             return Ok(());
@@ -385,15 +469,29 @@ impl ParameterServer {
 
     /// `set_parameters`: each parameter on its own, one result each.
     pub fn set(&mut self, core: &mut NodeCore, params: &[Parameter]) -> SetParametersResponse {
+        if params.len() > MAX_NAMES {
+            self.refused(
+                "set_parameters",
+                &format!(
+                    "set_parameters: {} parameters, only the first {MAX_NAMES} set",
+                    params.len()
+                ),
+            );
+        }
+        let params = &params[..params.len().min(MAX_NAMES)];
         let results = params
             .iter()
             .map(|p| {
                 let outcome = self.set_one(core, p);
-                log_outcome(p, &outcome);
+                self.log_outcome(p, &outcome);
                 result(outcome)
             })
             .collect();
-        SetParametersResponse { results }
+        let mut response = SetParametersResponse { results };
+        self.fit("set_parameters", &mut response, |r| {
+            r.results.pop().is_some()
+        });
+        response
     }
 
     /// `set_parameters_atomically`: all or none.
@@ -404,47 +502,103 @@ impl ParameterServer {
     ) -> SetParametersAtomicallyResponse {
         let mut config = core.engine().config().clone();
         let mut sim_time = self.use_sim_time;
-        let mut outcome = Ok(());
+        let mut outcome = if params.len() > MAX_NAMES {
+            Err(format!(
+                "{} parameters, at most {MAX_NAMES} at once",
+                params.len()
+            ))
+        } else {
+            Ok(())
+        };
         for p in params {
-            let step = if p.name == USE_SIM_TIME {
-                Self::sim_time_value(p).map(|b| sim_time = b)
-            } else {
-                self.changed(&config, p).map(|next| config = next)
-            };
-            if let Err(e) = step {
-                outcome = Err(format!("{}: {e}", p.name));
+            if outcome.is_err() {
                 break;
+            }
+            let step = oversized(p).and_then(|()| {
+                if p.name == USE_SIM_TIME {
+                    Self::sim_time_value(p).map(|b| sim_time = b)
+                } else {
+                    self.changed(&config, p).map(|next| config = next)
+                }
+            });
+            if let Err(e) = step {
+                outcome = Err(format!("{}: {e}", ConfigError::shortened(&p.name)));
             }
         }
         let outcome = outcome.and_then(|()| core.retune(config).map_err(|e| e.to_string()));
         if outcome.is_ok() {
             self.use_sim_time = sim_time;
         }
-        for p in params {
-            log_outcome(p, &outcome);
+        for p in params.iter().take(MAX_NAMES) {
+            self.log_outcome(p, &outcome);
         }
         SetParametersAtomicallyResponse {
-            result: result(outcome),
+            result: result(outcome.map_err(|e| ConfigError::shortened(&e))),
+        }
+    }
+
+    /// Logs an accepted set (each one: they are bounded by what can change) or a refusal
+    /// (rate-limited).
+    fn log_outcome(&mut self, p: &Parameter, outcome: &Result<(), String>) {
+        let name = ConfigError::shortened(&p.name);
+        match outcome {
+            Ok(()) => log::info!("parameter {name} set to {:?}", shown(&p.value)),
+            Err(e) => self.refused(
+                "parameter set refused",
+                &format!("parameter {name} not set: {e}"),
+            ),
         }
     }
 }
 
-fn log_outcome(p: &Parameter, outcome: &Result<(), String>) {
-    match outcome {
-        Ok(()) => log::info!("parameter {} set to {:?}", p.name, shown(&p.value)),
-        Err(e) => log::warn!("parameter {} not set: {e}", p.name),
+/// Refuses a name or a value longer than any parameter's, without quoting it.
+fn oversized(p: &Parameter) -> Result<(), String> {
+    if p.name.len() > MAX_NAME_BYTES {
+        return Err(format!(
+            "a parameter name of {} bytes (the longest is {MAX_NAME_BYTES})",
+            p.name.len()
+        ));
     }
+    let v = &p.value;
+    let longest_text = v
+        .string_array
+        .iter()
+        .map(String::len)
+        .chain([v.string_value.len()])
+        .max()
+        .unwrap_or(0);
+    let longest_list = [
+        v.byte_array.len(),
+        v.bool_array.len(),
+        v.int_array.len(),
+        v.double_array.len(),
+        v.string_array.len(),
+    ]
+    .into_iter()
+    .max()
+    .unwrap_or(0);
+    if longest_text > MAX_VALUE_LEN || longest_list > MAX_VALUE_LEN {
+        return Err(format!(
+            "a value with a text of {longest_text} bytes or a list of {longest_list} \
+             elements (at most {MAX_VALUE_LEN} each)"
+        ));
+    }
+    Ok(())
 }
 
 fn shown(v: &ParameterValue) -> String {
-    yaml_text(v, v.ptype)
-        .map(|t| t.trim_end().to_owned())
-        .unwrap_or_default()
+    ConfigError::shortened(
+        yaml_text(v, v.ptype)
+            .map(|t| t.trim_end().to_owned())
+            .unwrap_or_default()
+            .as_str(),
+    )
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::ros::node::params::NODE_PARAMETERS;
 
     fn double(v: f64) -> ParameterValue {
         ParameterValue {
@@ -478,7 +632,7 @@ mod tests {
         let all = list(&[], DEPTH_RECURSIVE);
         assert_eq!(
             all.names.len(),
-            c.parameters().len() + NODE_DESCRIPTIONS.len()
+            c.parameters().len() + NODE_PARAMETERS.len()
         );
         assert!(all.names.contains(&"use_sim_time".to_owned()));
         assert!(all.prefixes.contains(&"gnss".to_owned()));
@@ -502,7 +656,7 @@ mod tests {
 
     #[test]
     fn get_types_and_describe() {
-        let s = ParameterServer::new(true, OutputFrames::default());
+        let mut s = ParameterServer::new(true, OutputFrames::default());
         let c = Config::default();
         let n = names(&[
             "gnss.elevation_mask_deg",
@@ -655,5 +809,102 @@ mod tests {
             r.results[0].reason
         );
         assert_eq!(s.get(&c, &n).values[1].string_value, "imu_link");
+    }
+
+    #[test]
+    fn descriptions_ranges_and_read_only_flags_come_from_the_table() {
+        let mut s = ParameterServer::new(false, OutputFrames::default());
+        let c = Config::default();
+        let every: Vec<String> = s.all(&c).into_iter().map(|(n, _)| n).collect();
+        let d = s.describe(&c, &every).values;
+        assert_eq!(d.len(), every.len());
+        for (name, d) in every.iter().zip(&d) {
+            assert!(!d.description.is_empty(), "{name} undocumented");
+            let runtime = config::parameter(name)
+                .map(|p| p.runtime)
+                .or(NodeParameter::named(name).map(|p| p.runtime))
+                .unwrap();
+            assert_eq!(d.read_only, !runtime, "{name}");
+        }
+        let mask = &d[every
+            .iter()
+            .position(|n| n == "gnss.elevation_mask_deg")
+            .unwrap()];
+        assert!(
+            mask.description.contains("Unit: deg"),
+            "{}",
+            mask.description
+        );
+        let gap = &d[every
+            .iter()
+            .position(|n| n == "engine.imu_buffer_s")
+            .unwrap()];
+        assert_eq!(gap.floating_point_range[0].to_value, 60.0);
+        let window = &d[every
+            .iter()
+            .position(|n| n == "adaptive.window_size_m")
+            .unwrap()];
+        assert_eq!(window.integer_range[0].to_value, 10_000);
+        // Describing every parameter fits in a reply with room to spare.
+        let size = cdr::encode(&DescribeParametersResponse { values: d })
+            .unwrap()
+            .len();
+        assert!(size < MAX_REPLY_BYTES * 3 / 4, "{size} bytes");
+    }
+
+    /// Issue 12 item 13: 100 requests with 200 KB names added 74 MB and 40 MB of stderr;
+    /// each rejected name was logged and echoed, and a reply over ~64 KB never reaches a
+    /// Cyclone client.
+    #[test]
+    fn huge_names_and_values_get_bounded_replies_and_rate_limited_logs() {
+        let mut s = ParameterServer::new(false, OutputFrames::default());
+        let mut core = NodeCore::new(Config::default(), OutputFrames::default());
+        let c = Config::default();
+        let huge = "n".repeat(200_000);
+        let names: Vec<String> = (0..100).map(|i| format!("{huge}{i}")).collect();
+        let described = s.describe(&c, &names);
+        assert!(
+            reply_size(&described) <= MAX_REPLY_BYTES,
+            "{}",
+            reply_size(&described)
+        );
+        let got = s.get(&c, &names);
+        assert!(reply_size(&got) <= MAX_REPLY_BYTES);
+        let params: Vec<Parameter> = names.iter().map(|n| param(n, double(1.0))).collect();
+        let set = s.set(&mut core, &params);
+        assert!(reply_size(&set) <= MAX_REPLY_BYTES, "{}", reply_size(&set));
+        assert!(set
+            .results
+            .iter()
+            .all(|r| !r.successful && r.reason.len() < 200));
+        let atomic = s.set_atomically(&mut core, &params);
+        assert!(!atomic.result.successful && atomic.result.reason.len() < 300);
+        // A huge value for a real parameter is refused without being quoted.
+        let value = ParameterValue {
+            string_value: huge.clone(),
+            ..value(ParameterType::STRING)
+        };
+        let r = s.set(&mut core, &[param("filter.variant", value)]);
+        assert!(
+            !r.results[0].successful && r.results[0].reason.len() < 200,
+            "{}",
+            r.results[0].reason
+        );
+        // Every refusal was counted, only the 1st, 10th, 100th... of a kind logged.
+        assert_eq!(s.log.count("parameter set refused"), 201);
+        assert_eq!(s.log.logged("parameter set refused"), 3);
+        // Too many names: only the first MAX_NAMES are answered.
+        let many = vec!["gnss.elevation_mask_deg".to_owned(); 5 * MAX_NAMES];
+        let described = s.describe(&c, &many);
+        assert!(described.values.len() <= MAX_NAMES);
+        assert!(
+            reply_size(&described) <= MAX_REPLY_BYTES,
+            "{}",
+            reply_size(&described)
+        );
+    }
+
+    fn reply_size<T: serde::Serialize>(reply: &T) -> usize {
+        cdr::encode(reply).unwrap().len()
     }
 }

@@ -1,8 +1,16 @@
-//! The node's configuration from its command line: the params file (through the core's
-//! loader) and the `-p` overrides.
+//! The node's parameters from its command line: the parameter files and `-p` rules,
+//! resolved for the node as rclcpp resolves them ([`ParameterOverrides`]), split into the
+//! core's configuration and the node's own parameters (declared here). `replay` and
+//! `compare` read their `--params` files the same way ([`config_from_files`]).
 
-use crate::config::{Config, ConfigError};
-use crate::ros::args::{params_key_matches, NodeArgs};
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+use serde_yaml::Value;
+
+use crate::config::{manual::Row, Assignment, Config, ConfigError, Kind, MAX_FILE_BYTES};
+use crate::ros::args::{NodeArgs, ParameterSource, DEFAULT_NODE_NAME};
+use crate::ros::param_overrides::{node_matches, ParameterOverrides};
 
 /// Why the node's configuration could not be built.
 #[derive(Debug, thiserror::Error)]
@@ -12,26 +20,28 @@ pub enum ParamsError {
         path: String,
         source: std::io::Error,
     },
-    #[error("params file {path}: top-level key `{key}` does not address node `{fqn}` (use `/**`, the node name or its fully qualified name)")]
+    #[error("params file {path}: top-level key `{key}` does not address node `{fqn}` (use `/**`, the node name, its fully qualified name or a wildcard such as `/**/{name}`)")]
     WrongNode {
         path: String,
         key: String,
         fqn: String,
+        name: String,
     },
     #[error(transparent)]
     Config(Box<ConfigError>),
-    #[error("{name}: {reason}, not `{value}`")]
+    #[error("{origin}: parameter `{name}` = {value}: {reason}")]
     NodeParameter {
+        origin: String,
         name: &'static str,
         value: String,
         reason: &'static str,
     },
-    #[error("-p {name}:={value}: {source}")]
-    Override {
-        name: String,
-        value: String,
-        source: Box<ConfigError>,
-    },
+}
+
+impl From<ConfigError> for ParamsError {
+    fn from(e: ConfigError) -> Self {
+        Self::Config(Box::new(e))
+    }
 }
 
 /// The standard ROS parameter every launch file may set: the node's time (the
@@ -41,7 +51,6 @@ pub enum ParamsError {
 /// way (so a bag replayed with `--clock` is processed on the bag's time) and its outputs
 /// carry those stamps.
 pub const USE_SIM_TIME: &str = "use_sim_time";
-
 /// Frame of the odometry pose and the TF parent (REP-105 `map`: ENU at the datum).
 pub const MAP_FRAME: &str = "map_frame";
 /// Frame of the vehicle body (FLU), the odometry's child frame and NavSatFix's frame.
@@ -50,9 +59,6 @@ pub const BASE_FRAME: &str = "base_frame";
 pub const PUBLISH_TF: &str = "publish_tf";
 /// Depth (messages) of the input subscriptions' and the publishers' history.
 pub const QUEUE_DEPTH: &str = "queue_depth";
-/// The node's own parameters, outside the core configuration.
-pub const NODE_PARAMETERS: [&str; 5] =
-    [USE_SIM_TIME, MAP_FRAME, BASE_FRAME, PUBLISH_TF, QUEUE_DEPTH];
 
 /// Default of [`QUEUE_DEPTH`].
 ///
@@ -62,10 +68,104 @@ pub const DEFAULT_QUEUE_DEPTH: usize = 200;
 /// Largest accepted [`QUEUE_DEPTH`] (a minute of a 1 kHz IMU).
 pub const MAX_QUEUE_DEPTH: usize = 60_000;
 
-/// The frames of the node's outputs and whether it publishes them on `/tf`.
+/// One of the node's own parameters (outside the core configuration): its declaration
+/// for the parameter services and the reference.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct NodeParameter {
+    pub name: &'static str,
+    pub kind: Kind,
+    /// Default as YAML text.
+    pub default: &'static str,
+    /// Valid values, as the manual states them.
+    pub range: &'static str,
+    /// Whether it can change while the node runs.
+    pub runtime: bool,
+    pub doc: &'static str,
+}
+
+/// The node's own parameters.
 ///
-/// Choice: fixed at start (read-only through the parameter services): a TF tree whose
-/// frames change while it runs would break its listeners.
+/// Choice: the frames, the TF switch and the queue depth are fixed at start (read-only
+/// through the parameter services): a TF tree whose frames change while it runs would
+/// break its listeners, and the DDS entities are created with the depth.
+pub const NODE_PARAMETERS: [NodeParameter; 5] = [
+    NodeParameter {
+        name: USE_SIM_TIME,
+        kind: Kind::Bool,
+        default: "false",
+        range: "true or false",
+        runtime: true,
+        doc: "The node's time (diagnostics and rosout stamps, input ages) follows /clock.",
+    },
+    NodeParameter {
+        name: MAP_FRAME,
+        kind: Kind::Text,
+        default: "map",
+        range: "a frame id (non-empty, no spaces), not base_frame",
+        runtime: false,
+        doc: "Parent frame of odometry and /tf: ENU at the datum (REP-105 map).",
+    },
+    NodeParameter {
+        name: BASE_FRAME,
+        kind: Kind::Text,
+        default: "base_link",
+        range: "a frame id (non-empty, no spaces), not map_frame",
+        runtime: false,
+        doc: "Child frame of odometry and /tf, frame of fix: the vehicle body (FLU).",
+    },
+    NodeParameter {
+        name: PUBLISH_TF,
+        kind: Kind::Bool,
+        default: "false",
+        range: "true or false",
+        runtime: false,
+        doc: "Publish map_frame -> base_frame on /tf with each odometry.",
+    },
+    NodeParameter {
+        name: QUEUE_DEPTH,
+        kind: Kind::Integer,
+        default: "200",
+        range: "an integer in [1, 60000]",
+        runtime: false,
+        doc: "History depth (messages) of the input subscriptions and the publishers.",
+    },
+];
+
+impl NodeParameter {
+    /// The node parameter called `name`.
+    pub fn named(name: &str) -> Option<&'static NodeParameter> {
+        NODE_PARAMETERS.iter().find(|p| p.name == name)
+    }
+
+    /// The description the parameter services give.
+    pub fn description(&self) -> String {
+        format!(
+            "{} Range: {}. Default: {}",
+            self.doc, self.range, self.default
+        )
+    }
+
+    /// The row of the reference (`docs/parameters.md`).
+    pub fn row(&self) -> Row {
+        Row {
+            name: self.name.to_owned(),
+            kind: self.kind.name(),
+            unit: String::new(),
+            default: self.default.to_owned(),
+            range: self.range.to_owned(),
+            runtime: self.runtime,
+            doc: self.doc.to_owned(),
+        }
+    }
+}
+
+/// `docs/parameters.md`: the core's parameters and the node's.
+pub fn reference() -> String {
+    let rows: Vec<Row> = NODE_PARAMETERS.iter().map(NodeParameter::row).collect();
+    crate::config::manual::reference(&rows)
+}
+
+/// The frames of the node's outputs and whether it publishes them on `/tf`.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct OutputFrames {
     /// Parent frame of Odometry and TF (default `map`).
@@ -100,210 +200,159 @@ pub struct NodeParams {
     pub queue_depth: usize,
 }
 
-/// The value of the node parameter `name` from the params file and the `-p` overrides (the
-/// last one wins), as YAML; None when neither sets it.
-fn node_value(
-    args: &NodeArgs,
-    params_text: Option<&str>,
-    name: &'static str,
-) -> Result<Option<serde_yaml::Value>, ParamsError> {
-    let mut value = None;
-    let document = params_text.and_then(|t| serde_yaml::from_str::<serde_yaml::Value>(t).ok());
-    if let Some(serde_yaml::Value::Mapping(nodes)) = document {
-        for (_, node) in nodes {
-            if let Some(v) = node.get("ros__parameters").and_then(|p| p.get(name)) {
-                value = Some(v.clone());
-            }
-        }
-    }
-    for (_, v) in args.parameters.iter().filter(|(n, _)| n == name) {
-        let parsed = serde_yaml::from_str::<serde_yaml::Value>(v).map_err(|_| {
-            ParamsError::NodeParameter {
-                name,
-                value: v.clone(),
-                reason: "not a YAML value",
-            }
-        })?;
-        value = Some(parsed);
-    }
-    Ok(value)
-}
-
-fn node_bool(
-    args: &NodeArgs,
-    params_text: Option<&str>,
-    name: &'static str,
-    default: bool,
-) -> Result<bool, ParamsError> {
-    match node_value(args, params_text, name)? {
-        None => Ok(default),
-        Some(v) => v.as_bool().ok_or_else(|| ParamsError::NodeParameter {
-            name,
-            value: shown(&v),
-            reason: "must be true or false",
-        }),
-    }
-}
-
-/// A frame id: a non-empty string without spaces.
-fn node_frame(
-    args: &NodeArgs,
-    params_text: Option<&str>,
-    name: &'static str,
-    default: &str,
-) -> Result<String, ParamsError> {
-    match node_value(args, params_text, name)? {
-        None => Ok(default.to_owned()),
-        Some(serde_yaml::Value::String(s)) if !s.is_empty() && !s.contains(char::is_whitespace) => {
-            Ok(s)
-        }
-        Some(v) => Err(ParamsError::NodeParameter {
-            name,
-            value: shown(&v),
-            reason: "must be a frame id (a non-empty string without spaces)",
-        }),
-    }
-}
-
-/// A history depth: an integer in 1..=[`MAX_QUEUE_DEPTH`].
-fn node_depth(args: &NodeArgs, params_text: Option<&str>) -> Result<usize, ParamsError> {
-    match node_value(args, params_text, QUEUE_DEPTH)? {
-        None => Ok(DEFAULT_QUEUE_DEPTH),
-        Some(v) => v
-            .as_u64()
-            .and_then(|d| usize::try_from(d).ok())
-            .filter(|d| (1..=MAX_QUEUE_DEPTH).contains(d))
-            .ok_or_else(|| ParamsError::NodeParameter {
-                name: QUEUE_DEPTH,
-                value: shown(&v),
-                reason: "must be an integer from 1 to 60000",
-            }),
-    }
-}
-
-fn shown(v: &serde_yaml::Value) -> String {
-    serde_yaml::to_string(v)
-        .map(|t| t.trim_end().to_owned())
-        .unwrap_or_default()
-}
-
-fn frames_from(args: &NodeArgs, params_text: Option<&str>) -> Result<OutputFrames, ParamsError> {
+/// The node's parameters from the values resolved for it.
+pub fn node_params_from(values: &[Assignment]) -> Result<NodeParams, ParamsError> {
+    let (own, core): (Vec<&Assignment>, Vec<&Assignment>) = values
+        .iter()
+        .partition(|a| NodeParameter::named(&a.name).is_some());
+    let config = Config::default().with(core.into_iter().cloned())?;
+    let value = |name: &str| own.iter().find(|a| a.name == name).copied();
     let defaults = OutputFrames::default();
     let frames = OutputFrames {
-        map_frame: node_frame(args, params_text, MAP_FRAME, &defaults.map_frame)?,
-        base_frame: node_frame(args, params_text, BASE_FRAME, &defaults.base_frame)?,
-        publish_tf: node_bool(args, params_text, PUBLISH_TF, defaults.publish_tf)?,
+        map_frame: frame(value(MAP_FRAME), MAP_FRAME, &defaults.map_frame)?,
+        base_frame: frame(value(BASE_FRAME), BASE_FRAME, &defaults.base_frame)?,
+        publish_tf: boolean(value(PUBLISH_TF), PUBLISH_TF, defaults.publish_tf)?,
     };
     if frames.map_frame == frames.base_frame {
         return Err(ParamsError::NodeParameter {
+            origin: value(BASE_FRAME)
+                .or(value(MAP_FRAME))
+                .map_or_else(String::new, |a| a.origin.clone()),
             name: BASE_FRAME,
             value: frames.base_frame,
             reason: "must differ from map_frame",
         });
     }
-    Ok(frames)
-}
-
-/// The node's parameters of `args` where `params_text` is the content of
-/// `args.params_file` (None: no file).
-pub fn node_params_from(
-    args: &NodeArgs,
-    params_text: Option<&str>,
-) -> Result<NodeParams, ParamsError> {
     Ok(NodeParams {
-        config: config_from(args, params_text)?,
-        use_sim_time: node_bool(args, params_text, USE_SIM_TIME, false)?,
-        frames: frames_from(args, params_text)?,
-        queue_depth: node_depth(args, params_text)?,
+        config,
+        use_sim_time: boolean(value(USE_SIM_TIME), USE_SIM_TIME, false)?,
+        frames,
+        queue_depth: depth(value(QUEUE_DEPTH))?,
     })
 }
 
-/// The configuration of `args` where `params_text` is the content of `args.params_file`
-/// (None: no file; the defaults of `params/ekf.yaml` apply).
-pub fn config_from(args: &NodeArgs, params_text: Option<&str>) -> Result<Config, ParamsError> {
-    let origin = args
-        .params_file
-        .as_ref()
-        .map_or_else(String::new, |p| p.display().to_string());
-    let mut config = match params_text {
-        Some(text) => {
-            check_node_key(text, &origin, args)?;
-            let text = without_node_parameters(text);
-            Config::from_yaml_str(&text, &origin).map_err(|e| ParamsError::Config(Box::new(e)))?
-        }
-        None => Config::default(),
-    };
-    let core = |n: &String| !NODE_PARAMETERS.contains(&n.as_str());
-    for (name, value) in args.parameters.iter().filter(|(n, _)| core(n)) {
-        config
-            .set_parameter(name, value)
-            .map_err(|source| ParamsError::Override {
-                name: name.clone(),
-                value: value.clone(),
-                source: Box::new(source),
-            })?;
+fn refused(a: &Assignment, name: &'static str, reason: &'static str) -> ParamsError {
+    ParamsError::NodeParameter {
+        origin: a.origin.clone(),
+        name,
+        value: ConfigError::shortened(&crate::config::yaml_text(&a.value)),
+        reason,
     }
-    Ok(config)
 }
 
-/// `text` without the [`NODE_PARAMETERS`] under its node's `ros__parameters` (unchanged,
-/// keeping the line numbers of the loader's errors, when there is none).
-fn without_node_parameters(text: &str) -> std::borrow::Cow<'_, str> {
-    use serde_yaml::Value;
-    let Ok(mut document) = serde_yaml::from_str::<Value>(text) else {
-        return text.into();
+fn boolean(a: Option<&Assignment>, name: &'static str, default: bool) -> Result<bool, ParamsError> {
+    match a {
+        None => Ok(default),
+        Some(a) => a
+            .value
+            .as_bool()
+            .ok_or_else(|| refused(a, name, "must be true or false")),
+    }
+}
+
+/// A frame id: a non-empty string without spaces.
+fn frame(a: Option<&Assignment>, name: &'static str, default: &str) -> Result<String, ParamsError> {
+    match a {
+        None => Ok(default.to_owned()),
+        Some(Assignment {
+            value: Value::String(s),
+            ..
+        }) if !s.is_empty() && !s.contains(char::is_whitespace) => Ok(s.clone()),
+        Some(a) => Err(refused(
+            a,
+            name,
+            "must be a frame id (a non-empty string without spaces)",
+        )),
+    }
+}
+
+/// A history depth: an integer in 1..=[`MAX_QUEUE_DEPTH`].
+fn depth(a: Option<&Assignment>) -> Result<usize, ParamsError> {
+    match a {
+        None => Ok(DEFAULT_QUEUE_DEPTH),
+        Some(a) => a
+            .value
+            .as_u64()
+            .and_then(|d| usize::try_from(d).ok())
+            .filter(|d| (1..=MAX_QUEUE_DEPTH).contains(d))
+            .ok_or_else(|| refused(a, QUEUE_DEPTH, "must be an integer from 1 to 60000")),
+    }
+}
+
+/// Reads a parameter file of at most [`MAX_FILE_BYTES`] (a larger one is refused without
+/// being read whole).
+pub fn read_params_file(path: &Path) -> Result<String, ParamsError> {
+    let read_error = |source| ParamsError::Read {
+        path: path.display().to_string(),
+        source,
     };
-    let mut removed = false;
-    if let Value::Mapping(nodes) = &mut document {
-        for (_, node) in nodes.iter_mut() {
-            if let Some(Value::Mapping(parameters)) = node.get_mut("ros__parameters") {
-                for name in NODE_PARAMETERS {
-                    removed |= parameters.remove(name).is_some();
+    let file = std::fs::File::open(path).map_err(read_error)?;
+    let mut bytes = Vec::new();
+    file.take(MAX_FILE_BYTES as u64 + 1)
+        .read_to_end(&mut bytes)
+        .map_err(read_error)?;
+    if bytes.len() > MAX_FILE_BYTES {
+        return Err(ConfigError::TooLarge {
+            origin: path.display().to_string(),
+            limit: MAX_FILE_BYTES,
+        }
+        .into());
+    }
+    String::from_utf8(bytes)
+        .map_err(|e| read_error(std::io::Error::new(std::io::ErrorKind::InvalidData, e)))
+}
+
+/// The overrides of `sources` for the node `fqn`: each file read and parsed, each rule
+/// parsed; a file none of whose entries addresses the node is an error.
+fn overrides(
+    sources: &[ParameterSource],
+    fqn: &str,
+    name: &str,
+) -> Result<ParameterOverrides, ParamsError> {
+    let mut overrides = ParameterOverrides::default();
+    for source in sources {
+        match source {
+            ParameterSource::File(path) => {
+                let text = read_params_file(path)?;
+                let origin = path.display().to_string();
+                let nodes = overrides.add_file(&text, &origin)?;
+                // Choice: rcl silently ignores entries for other nodes; a file none of
+                // whose entries is for this node is almost certainly a mistake.
+                if !nodes.iter().any(|n| node_matches(n, fqn)) {
+                    return Err(ParamsError::WrongNode {
+                        path: origin,
+                        key: ConfigError::shortened(&nodes.join(", ")),
+                        fqn: fqn.to_owned(),
+                        name: name.to_owned(),
+                    });
                 }
+            }
+            ParameterSource::Rule { node, name, value } => {
+                overrides.add_rule(node.as_deref(), name, value)?
             }
         }
     }
-    match (removed, serde_yaml::to_string(&document)) {
-        (true, Ok(stripped)) => stripped.into(),
-        _ => text.into(),
-    }
+    Ok(overrides)
 }
 
-/// Rejects a file whose single top-level key names another node. Files of any other shape
-/// are left to the core's loader, whose errors describe the expected layout.
-fn check_node_key(text: &str, origin: &str, args: &NodeArgs) -> Result<(), ParamsError> {
-    let Ok(serde_yaml::Value::Mapping(top)) = serde_yaml::from_str(text) else {
-        return Ok(());
-    };
-    for key in top.keys().filter_map(|k| k.as_str()) {
-        if !params_key_matches(key, &args.namespace, &args.node_name) {
-            let fqn = if args.namespace == "/" {
-                format!("/{}", args.node_name)
-            } else {
-                format!("{}/{}", args.namespace, args.node_name)
-            };
-            return Err(ParamsError::WrongNode {
-                path: origin.to_owned(),
-                key: key.to_owned(),
-                fqn,
-            });
-        }
-    }
-    Ok(())
-}
-
-/// Reads `args.params_file` (if any) and builds the node's parameters.
+/// Reads the parameter files of `args` and builds the node's parameters.
 pub fn load(args: &NodeArgs) -> Result<NodeParams, ParamsError> {
-    let text = match &args.params_file {
-        Some(path) => Some(
-            std::fs::read_to_string(path).map_err(|source| ParamsError::Read {
-                path: path.display().to_string(),
-                source,
-            })?,
-        ),
-        None => None,
-    };
-    node_params_from(args, text.as_deref())
+    let fqn = args.fully_qualified_name();
+    let overrides = overrides(&args.parameter_sources, &fqn, &args.node_name)?;
+    node_params_from(&overrides.for_node(&fqn))
+}
+
+/// The configuration of `replay`, `compare` and `spp` from their `--params` files, read
+/// in order (a later value wins) for the node `/gnss_ins_node` (as the node started with
+/// its default name reads them). The node's own parameters are accepted and ignored.
+pub fn config_from_files(paths: &[PathBuf]) -> Result<Config, ParamsError> {
+    let sources: Vec<ParameterSource> = paths.iter().cloned().map(ParameterSource::File).collect();
+    let fqn = format!("/{DEFAULT_NODE_NAME}");
+    let values = overrides(&sources, &fqn, DEFAULT_NODE_NAME)?.for_node(&fqn);
+    let core = values
+        .into_iter()
+        .filter(|a| NodeParameter::named(&a.name).is_none());
+    Ok(Config::default().with(core)?)
 }
 
 #[cfg(test)]
@@ -313,44 +362,88 @@ mod tests {
 
     const FILE: &str = "gnss_ins_node:\n  ros__parameters:\n    filter:\n      variant: ermakf\n";
 
-    fn args(extra: &[&str]) -> NodeArgs {
-        let mut all = vec!["--ros-args", "--params-file", "p.yaml"];
-        all.extend_from_slice(extra);
-        parse(all.iter().copied()).unwrap()
+    /// Loads with parameter files holding `files` (each written to a temporary file and
+    /// given with --params-file, in order) followed by the ROS arguments `extra`.
+    fn load_with(files: &[&str], extra: &[&str]) -> Result<NodeParams, ParamsError> {
+        let dir = tempfile::tempdir().unwrap();
+        let mut all = vec!["--ros-args".to_owned()];
+        for (i, text) in files.iter().enumerate() {
+            let path = dir.path().join(format!("p{i}.yaml"));
+            std::fs::write(&path, text).unwrap();
+            all.extend(["--params-file".to_owned(), path.display().to_string()]);
+        }
+        all.extend(extra.iter().map(|s| s.to_string()));
+        load(&parse(all).unwrap())
+    }
+
+    fn variant(p: &NodeParams) -> &'static str {
+        p.config.filter.variant.as_str()
     }
 
     #[test]
     fn file_then_overrides() {
-        let c = config_from(&args(&[]), Some(FILE)).unwrap();
-        assert_eq!(c.filter.variant.as_str(), "ermakf");
-        let c = config_from(&args(&["-p", "filter.variant:=ekf"]), Some(FILE)).unwrap();
-        assert_eq!(c.filter.variant.as_str(), "ekf");
+        assert_eq!(variant(&load_with(&[FILE], &[]).unwrap()), "ermakf");
+        let p = load_with(&[FILE], &["-p", "filter.variant:=ekf"]).unwrap();
+        assert_eq!(variant(&p), "ekf");
     }
 
     #[test]
-    fn wildcard_and_qualified_keys_are_accepted() {
+    fn any_number_of_files_apply_in_order() {
+        let base = FILE.replace("ermakf", "ekf") + "    gnss:\n      pseudorange_sigma_m: 4.0\n";
+        let p = load_with(&[&base, FILE], &[]).unwrap();
+        assert_eq!(variant(&p), "ermakf", "the later file wins");
+        assert_eq!(
+            p.config.gnss.pseudorange_sigma_m, 4.0,
+            "the earlier file's other keys stay"
+        );
+        let p = load_with(&[FILE, &base], &[]).unwrap();
+        assert_eq!(variant(&p), "ekf");
+    }
+
+    #[test]
+    fn wildcard_qualified_and_dotted_keys_are_accepted() {
         let any = FILE.replace("gnss_ins_node:", "/**:");
-        assert!(config_from(&args(&[]), Some(&any)).is_ok());
+        assert_eq!(variant(&load_with(&[&any], &[]).unwrap()), "ermakf");
         let fq = FILE.replace("gnss_ins_node:", "/r1/ins:");
-        assert!(config_from(&args(&["-r", "__ns:=/r1", "-r", "__node:=ins"]), Some(&fq)).is_ok());
+        let p = load_with(&[&fq], &["-r", "__ns:=/r1", "-r", "__node:=ins"]).unwrap();
+        assert_eq!(variant(&p), "ermakf");
+        let pattern = FILE.replace("gnss_ins_node:", "/**/ins:");
+        let p = load_with(&[&pattern], &["-r", "__ns:=/r1", "-r", "__node:=ins"]).unwrap();
+        assert_eq!(variant(&p), "ermakf");
+        let dotted = "/**:\n  ros__parameters:\n    filter.variant: ermakf\n    publish_tf: true\n";
+        let p = load_with(&[dotted], &[]).unwrap();
+        assert_eq!(variant(&p), "ermakf");
+        assert!(p.frames.publish_tf);
+        let p = load_with(&[], &["-p", "gnss_ins_node:filter.variant:=iarf"]).unwrap();
+        assert_eq!(variant(&p), "iarf");
+        let p = load_with(&[], &["-p", "other:filter.variant:=iarf"]).unwrap();
+        assert_eq!(variant(&p), "ekf", "a rule for another node");
     }
 
     #[test]
     fn file_for_another_node_is_rejected() {
-        let e = config_from(&args(&["-r", "__node:=ins"]), Some(FILE)).unwrap_err();
+        let e = load_with(&[FILE], &["-r", "__node:=ins"]).unwrap_err();
         let text = e.to_string();
         assert!(matches!(e, ParamsError::WrongNode { .. }), "{text}");
         assert!(
-            text.contains("gnss_ins_node") && text.contains("/ins"),
+            text.contains("gnss_ins_node") && text.contains("`/ins`"),
             "{text}"
         );
+        // A file with an entry for this node and one for another is fine (rcl).
+        let two = format!("{FILE}other_node:\n  ros__parameters:\n    x: 1\n");
+        assert_eq!(variant(&load_with(&[&two], &[]).unwrap()), "ermakf");
     }
 
     #[test]
     fn bad_override_names_the_parameter() {
-        let e = config_from(&args(&["-p", "filter.no_such_key:=1"]), Some(FILE)).unwrap_err();
-        assert!(matches!(e, ParamsError::Override { .. }), "{e}");
-        assert!(e.to_string().contains("filter.no_such_key"), "{e}");
+        let e = load_with(&[FILE], &["-p", "filter.no_such_key:=1"]).unwrap_err();
+        let text = e.to_string();
+        assert!(
+            text.contains("filter.no_such_key") && text.starts_with("-p "),
+            "{text}"
+        );
+        let e = load_with(&[FILE], &["-p", "filter.variant:=ukf"]).unwrap_err();
+        assert!(e.to_string().starts_with("-p filter.variant:=ukf: "), "{e}");
     }
 
     #[test]
@@ -363,54 +456,89 @@ mod tests {
             Config::from_yaml_str(&file, "p.yaml").is_err(),
             "the core's loader alone refuses the key"
         );
-        let c = config_from(&args(&["-p", "use_sim_time:=true"]), Some(&file)).unwrap();
-        assert_eq!(c.filter.variant.as_str(), "ermakf");
-        let p = node_params_from(&args(&[]), Some(&file)).unwrap();
+        let p = load_with(&[&file], &[]).unwrap();
         assert!(p.use_sim_time, "from the file");
-        let p = node_params_from(&args(&["-p", "use_sim_time:=false"]), Some(&file)).unwrap();
+        assert_eq!(variant(&p), "ermakf");
+        let p = load_with(&[&file], &["-p", "use_sim_time:=false"]).unwrap();
         assert!(!p.use_sim_time, "-p wins over the file");
-        assert!(
-            !node_params_from(&args(&[]), Some(FILE))
-                .unwrap()
-                .use_sim_time
-        );
-        let e = node_params_from(&args(&["-p", "use_sim_time:=maybe"]), Some(FILE));
-        assert!(matches!(e, Err(ParamsError::NodeParameter { .. })));
-        // Files without it keep the loader's line numbers in errors.
+        assert!(!load_with(&[FILE], &[]).unwrap().use_sim_time);
+        let e = load_with(&[FILE], &["-p", "use_sim_time:=maybe"]);
+        assert!(matches!(e, Err(ParamsError::NodeParameter { .. })), "{e:?}");
         let bad = FILE.replace("ermakf", "no_such_variant");
-        let e = config_from(&args(&[]), Some(&bad)).unwrap_err().to_string();
-        assert!(e.contains("p.yaml"), "{e}");
+        let e = load_with(&[&bad], &[]).unwrap_err().to_string();
+        assert!(e.contains("p0.yaml") && e.contains("filter.variant"), "{e}");
     }
 
     #[test]
-    fn every_shipped_preset_loads() {
+    fn every_shipped_preset_loads_over_the_manual() {
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("params");
-        for entry in std::fs::read_dir(dir).unwrap() {
+        let manual = dir.join("ekf.yaml");
+        for entry in std::fs::read_dir(&dir).unwrap() {
             let path = entry.unwrap().path();
-            let text = std::fs::read_to_string(&path).unwrap();
-            let a = parse(["--ros-args", "--params-file", path.to_str().unwrap()]).unwrap();
-            config_from(&a, Some(&text)).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            config_from_files(&[manual.clone(), path.clone()])
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         }
     }
 
     #[test]
-    fn queue_depth_is_the_nodes_and_checked() {
-        let p = node_params_from(&args(&[]), None).unwrap();
-        assert_eq!(p.queue_depth, DEFAULT_QUEUE_DEPTH);
-        let p = node_params_from(&args(&["-p", "queue_depth:=1000"]), None).unwrap();
-        assert_eq!(p.queue_depth, 1000);
-        for bad in ["0", "-3", "2.5", "deep", "60001"] {
-            let set = format!("queue_depth:={bad}");
-            assert!(
-                node_params_from(&args(&["-p", &set]), None).is_err(),
-                "{bad} accepted"
+    fn tools_ignore_the_nodes_own_parameters() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("p.yaml");
+        let text = "/**:\n  ros__parameters:\n    use_sim_time: true\n    map_frame: odom\n    filter.variant: iarf\n";
+        std::fs::write(&path, text).unwrap();
+        let config = config_from_files(&[path]).unwrap();
+        assert_eq!(config.filter.variant.as_str(), "iarf");
+    }
+
+    #[test]
+    fn a_file_over_the_size_limit_is_refused_unread() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("big.yaml");
+        let file = std::fs::File::create(&path).unwrap();
+        // Sparse: 1 GB on disk costs nothing, and is not read.
+        file.set_len(1 << 30).unwrap();
+        let e = config_from_files(&[path]).unwrap_err();
+        assert!(
+            matches!(&e, ParamsError::Config(c) if matches!(**c, ConfigError::TooLarge { .. })),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn declared_defaults_are_the_loaded_ones() {
+        let p = load_with(&[], &[]).unwrap();
+        let loaded = [
+            (USE_SIM_TIME, Value::Bool(p.use_sim_time)),
+            (MAP_FRAME, p.frames.map_frame.into()),
+            (BASE_FRAME, p.frames.base_frame.into()),
+            (PUBLISH_TF, Value::Bool(p.frames.publish_tf)),
+            (QUEUE_DEPTH, Value::from(p.queue_depth)),
+        ];
+        for (name, value) in loaded {
+            let declared = NodeParameter::named(name).unwrap().default;
+            assert_eq!(
+                serde_yaml::from_str::<Value>(declared).unwrap(),
+                value,
+                "{name}"
             );
         }
     }
 
     #[test]
+    fn queue_depth_is_the_nodes_and_checked() {
+        let p = load_with(&[], &[]).unwrap();
+        assert_eq!(p.queue_depth, DEFAULT_QUEUE_DEPTH);
+        let p = load_with(&[], &["-p", "queue_depth:=1000"]).unwrap();
+        assert_eq!(p.queue_depth, 1000);
+        for bad in ["0", "-3", "2.5", "deep", "60001"] {
+            let set = format!("queue_depth:={bad}");
+            assert!(load_with(&[], &["-p", &set]).is_err(), "{bad} accepted");
+        }
+    }
+
+    #[test]
     fn frames_and_publish_tf_are_the_nodes() {
-        let p = node_params_from(&args(&[]), Some(FILE)).unwrap();
+        let p = load_with(&[FILE], &[]).unwrap();
         assert_eq!(p.frames, OutputFrames::default());
         assert_eq!(p.frames.map_frame, "map");
         assert_eq!(p.frames.base_frame, "base_link");
@@ -419,12 +547,12 @@ mod tests {
             "ros__parameters:\n",
             "ros__parameters:\n    map_frame: odom_enu\n    publish_tf: true\n",
         );
-        let p = node_params_from(&args(&["-p", "base_frame:=imu_link"]), Some(&file)).unwrap();
-        assert_eq!(p.config.filter.variant.as_str(), "ermakf");
+        let p = load_with(&[&file], &["-p", "base_frame:=imu_link"]).unwrap();
+        assert_eq!(variant(&p), "ermakf");
         assert_eq!(p.frames.map_frame, "odom_enu");
         assert_eq!(p.frames.base_frame, "imu_link");
         assert!(p.frames.publish_tf);
-        let p = node_params_from(&args(&["-p", "publish_tf:=false"]), Some(&file)).unwrap();
+        let p = load_with(&[&file], &["-p", "publish_tf:=false"]).unwrap();
         assert!(!p.frames.publish_tf, "-p wins over the file");
         for bad in [
             "publish_tf:=yes please",
@@ -432,7 +560,7 @@ mod tests {
             "map_frame:=12",
             "base_frame:=map",
         ] {
-            let e = node_params_from(&args(&["-p", bad]), Some(FILE));
+            let e = load_with(&[FILE], &["-p", bad]);
             assert!(
                 matches!(e, Err(ParamsError::NodeParameter { .. })),
                 "{bad}: {e:?}"

@@ -1,0 +1,383 @@
+//! THE parameter table: every parameter of the configuration, declared once with its SI
+//! field, file key, type, default, unit, valid range, whether it can change while the
+//! node runs, its SI conversion and its manual text (the doc comment). See `table.rs` for
+//! the form of a declaration.
+//!
+//! Everything else comes from here: the section structs and their defaults, loading and
+//! checking a file or a `-p` value, the echo, the parameter services' descriptions and
+//! read-only flags, the retune rule, `params/ekf.yaml` and `docs/parameters.md` (both
+//! generated and checked by `tests/parameter_manual.rs`). Checks that relate two
+//! parameters are in `validate.rs`.
+
+use nalgebra::{UnitQuaternion, Vector3};
+
+use super::convert::{
+    ByName, LlhDegToPosition, RpyDegToRotation, Scale, ToVector, M_S2_PER_UG, RAD_PER_DEG,
+    RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H, RAD_S_PER_DEG_H,
+};
+use super::file_value::ConstellationName;
+use super::spec::{Interval, Range};
+use super::table::parameter_table;
+use super::{AdaptiveFactorKind, Coupling, EquivalentWeightKind, FilterBase, FilterVariant};
+use crate::adaptive::burg::OrderCriterion;
+use crate::earth::Llh;
+use crate::gnss::Constellation;
+
+/// Choice: a 1-sigma (or a noise density) lies between 1e-9 and 1e6 of its unit: below,
+/// the filter would trust a sensor beyond any physical one; above, the squares (1e12 and
+/// more) swamp every other term of the covariance, and 1e300 overflows it to infinity.
+const SIGMA: Range = Range::Within(Interval::closed(1e-9, 1e6));
+/// Choice: a correlation time lies between 1 ms (shorter is white noise at any IMU rate)
+/// and 1e7 s (four months, beyond which the process is a constant); 1e-300 s makes the
+/// discretised process noise overflow.
+const TIME_CONSTANT: Range = Range::Within(Interval::closed(1e-3, 1e7));
+/// Choice: a threshold on a standardized residual, in sigmas, above 0; beyond 1000 sigma
+/// it never acts.
+const THRESHOLD: Range = Range::Within(Interval::above(0.0, 1e3));
+/// Choice: an epoch window holds at most 1e4 epochs (almost three hours at 1 Hz): every
+/// estimator of the table converges within a few hundred, and a window is allocated per
+/// satellite, so 1e9 would ask for tens of gigabytes.
+const MAX_WINDOW_EPOCHS: u64 = 10_000;
+/// A fraction in (0, 1].
+const FRACTION: Range = Range::Within(Interval::above(0.0, 1.0));
+/// A factor bound at least 1 (and finite).
+const FACTOR_MAX: Range = Range::Within(Interval::closed(1.0, 1e12));
+const ANY: Range = Range::Any;
+
+parameter_table! {
+    /// Which filter runs and how its update is formed.
+    section filter: FilterConfig {
+        /// Filter variant (enum). ekf = error-state extended Kalman filter with the fixed
+        /// noise of this file: the baseline the adaptive variants are compared against.
+        /// ERMAKF paper: eiakf (innovation-based R), srmakf, ermakf (redundant-measurement
+        /// R, see adaptive.*). IARF paper (section 5 schemes, constants in robust.*): ckf
+        /// (cubature filter), akf_all (adaptive factor at every epoch), akf_partial
+        /// (adaptive factor only at epochs passing the Mahalanobis test), iarf (robust
+        /// equivalent R at every epoch + adaptive factor at epochs passing the test). Ding,
+        /// Wang and Rizos: residual_akf (R from the post-update residuals, eqs. 14-15).
+        variant: FilterVariant = FilterVariant::Ekf, unit "", range ANY, at_start;
+        /// What is taken from the receiver (enum). tight = per-satellite pseudo-ranges and
+        /// pseudo-range rates (gnss.*); loose = the receiver's position/velocity fix
+        /// (loose.*).
+        coupling: Coupling = Coupling::Tight, unit "", range ANY, at_start;
+        /// Joseph-form covariance update P = (I-KH)P(I-KH)^T + KRK^T (stays symmetric and
+        /// positive definite under rounding). false = the short form P = (I-KH)P.
+        joseph_form: bool = true, unit "", range ANY, at_start;
+        /// Base filter of the measurement update (enum). ekf = linearized update; cubature
+        /// = cubature Kalman filter (2n points through the full measurement model; the
+        /// covariance time update stays the linearized one); auto = cubature for ckf,
+        /// akf_all, akf_partial and iarf (the IARF paper runs all its schemes on the CKF),
+        /// ekf for the other variants. akf_all, akf_partial and iarf also run on base ekf;
+        /// ckf with base ekf is refused (that is variant ekf).
+        base: FilterBase = FilterBase::Auto, unit "", range ANY, at_start;
+        /// Ding's process-noise scaling (eqs. 19, 22): Q is multiplied by sqrt(alpha) once
+        /// per full window of robust.q_window_epochs, alpha = observed / predicted
+        /// innovation power. Combines with every variant.
+        q_scaling: bool = false, unit "", range ANY, at_start;
+    }
+
+    /// Inertial sensor noise, in data-sheet units.
+    section imu: ImuConfig {
+        /// Gyro angle random walk (white rate noise density), from the data sheet.
+        gyro_arw_rad_per_sqrt_s: f64 ["gyro_arw_deg_per_sqrt_h": f64] = 0.012,
+            unit "deg/sqrt(h)", range SIGMA, at_start,
+            si Scale::to("rad/sqrt(s)", RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H);
+        /// Initial 1-sigma of the constant (turn-on) gyro bias, per axis.
+        gyro_bias_sigma_rad_s: f64 ["gyro_bias_deg_per_h": f64] = 0.5,
+            unit "deg/h", range SIGMA, at_start, si Scale::to("rad/s", RAD_S_PER_DEG_H);
+        /// Steady-state 1-sigma of the first-order Gauss-Markov gyro drift, per axis.
+        gyro_markov_sigma_rad_s: f64 ["gyro_markov_sigma_deg_per_h": f64] = 0.5,
+            unit "deg/h", range SIGMA, at_start, si Scale::to("rad/s", RAD_S_PER_DEG_H);
+        /// Correlation time of the gyro Gauss-Markov drift.
+        gyro_markov_time_s: f64 ["gyro_markov_correlation_time_s": f64] = 3600.0,
+            unit "s", range TIME_CONSTANT, at_start;
+        /// Accelerometer velocity random walk (white specific-force noise density).
+        accel_vrw_m_s_per_sqrt_s: f64 ["accel_vrw_ug_per_sqrt_hz": f64] = 100.0,
+            unit "ug/sqrt(Hz)", range SIGMA, at_start, si Scale::to("m/s/sqrt(s)", M_S2_PER_UG);
+        /// Steady-state 1-sigma of the first-order Gauss-Markov accelerometer bias, per
+        /// axis.
+        accel_bias_sigma_m_s2: f64 ["accel_bias_ug": f64] = 1250.0,
+            unit "ug", range SIGMA, at_start, si Scale::to("m/s^2", M_S2_PER_UG);
+        /// Correlation time of the accelerometer Gauss-Markov bias.
+        accel_markov_time_s: f64 ["accel_bias_correlation_time_s": f64] = 3600.0,
+            unit "s", range TIME_CONSTANT, at_start;
+    }
+
+    /// IMU orientation and antenna lever arm.
+    section mounting: MountingConfig {
+        /// Rotation taking IMU-frame vectors into the body frame (FLU): [roll, pitch, yaw]
+        /// about x, y, z, composed as R = Rz(yaw) * Ry(pitch) * Rx(roll). [0, 0, 0] = the
+        /// IMU axes are the body axes.
+        imu_to_body: UnitQuaternion<f64> ["imu_rotation_rpy_deg": [f64; 3]] = [0.0, 0.0, 0.0],
+            unit "deg",
+            range Range::Components([
+                ("roll", Interval::closed(-180.0, 180.0), "deg"),
+                ("pitch", Interval::closed(-90.0, 90.0), "deg"),
+                ("yaw", Interval::closed(-180.0, 180.0), "deg"),
+            ]),
+            at_start, si RpyDegToRotation;
+        /// GNSS antenna phase centre relative to the IMU, in the body frame [forward, left,
+        /// up].
+        // Choice: a lever arm beyond 100 m is taken as a unit mistake (cm or mm as m).
+        lever_arm_b_m: Vector3<f64> ["antenna_lever_arm_m": [f64; 3]] = [0.0, 0.0, 0.0],
+            unit "m", range Range::Within(Interval::closed(-100.0, 100.0)), at_start,
+            si ToVector;
+    }
+
+    /// Receiver clock model: bias c*dt_u (m) and drift c*dt_ru (m/s). The defaults are a
+    /// typical TCXO (Allan coefficients h0 = 2e-19, h-2 = 2e-20, Brown & Hwang):
+    /// sqrt(h0/2)*c = 0.1 m/sqrt(s), sqrt(2 pi^2 h-2)*c = 0.2 (m/s)/sqrt(s).
+    section clock: ClockConfig {
+        /// White noise driving the receiver clock bias c*dt_u (random walk).
+        bias_noise_m_per_sqrt_s: f64 = 0.1, unit "m/sqrt(s)", range SIGMA, at_start;
+        /// White noise driving the receiver clock drift c*dt_ru (Gauss-Markov).
+        drift_noise_m_s_per_sqrt_s: f64 ["drift_noise_mps_per_sqrt_s": f64] = 0.2,
+            unit "(m/s)/sqrt(s)", range SIGMA, at_start;
+        /// Correlation time of the clock drift.
+        drift_time_s: f64 ["drift_correlation_time_s": f64] = 1800.0,
+            unit "s", range TIME_CONSTANT, at_start;
+    }
+
+    /// Raw measurement selection and weighting (tight coupling).
+    section gnss: GnssConfig {
+        /// Satellites below this elevation are not used.
+        elevation_mask_rad: f64 ["elevation_mask_deg": f64] = 10.0,
+            unit "deg", range Range::Within(Interval::below(0.0, 90.0)), at_run_time,
+            si Scale::to("rad", RAD_PER_DEG);
+        /// Satellites below this carrier-to-noise density are not used. 0 = off.
+        cn0_mask_dbhz: f64 = 0.0,
+            unit "dB-Hz", range Range::Within(Interval::closed(0.0, 100.0)), at_run_time;
+        /// Zenith 1-sigma of a pseudo-range.
+        pseudorange_sigma_m: f64 = 3.0, unit "m", range SIGMA, at_run_time;
+        /// Zenith 1-sigma of a pseudo-range rate.
+        pseudorange_rate_sigma_mps: f64 = 0.1, unit "m/s", range SIGMA, at_run_time;
+        /// Scale the zenith sigmas by 1 / sin(elevation).
+        elevation_weighting: bool = true, unit "", range ANY, at_run_time;
+        /// Use the sigmas the receiver reports with each measurement when present (the
+        /// zenith sigmas above otherwise).
+        use_receiver_sigmas: bool = false, unit "", range ANY, at_run_time;
+        /// Fuse pseudo-range rates as well as pseudo-ranges.
+        use_pseudorange_rate: bool = true, unit "", range ANY, at_start;
+        /// Reject a measurement whose |innovation| > gate * sqrt(S), S its innovation
+        /// variance. 0 = off.
+        // Choice: a gate below 1 sigma would reject most good measurements.
+        innovation_gate_sigma: f64 = 5.0,
+            unit "sigma", range Range::OffOrWithin(Interval::closed(1.0, 1e6)), at_run_time;
+        /// Constellations used. Names: gps, glonass, galileo, beidou, qzss, sbas.
+        constellations: Vec<Constellation> ["constellations": Vec<ConstellationName>] = vec![
+                ConstellationName::Gps,
+                ConstellationName::Galileo,
+                ConstellationName::Beidou,
+            ],
+            unit "", range Range::EachOnce, at_start, si ByName;
+        /// A pseudo-range step common to all satellites larger than this is absorbed as a
+        /// receiver clock jump (receivers jump whole milliseconds, about 300 km).
+        max_clock_jump_m: f64 ["clock_jump_threshold_m": f64] = 100_000.0,
+            unit "m", range Range::Within(Interval::above(0.0, 1e7)), at_run_time;
+    }
+
+    /// Weighting of the receiver fix in loose coupling.
+    section loose: LooseConfig {
+        /// true = weight the receiver fix by the covariance published with it; false = by
+        /// the sigmas below.
+        use_fix_covariance: bool = true, unit "", range ANY, at_run_time;
+        /// Horizontal 1-sigma of a receiver position fix.
+        fix_sigma_horizontal_m: f64 = 1.5, unit "m", range SIGMA, at_run_time;
+        /// Vertical 1-sigma of a receiver position fix.
+        fix_sigma_vertical_m: f64 = 3.0, unit "m", range SIGMA, at_run_time;
+        /// 1-sigma of each component of the receiver velocity.
+        velocity_sigma_mps: f64 = 0.1, unit "m/s", range SIGMA, at_run_time;
+    }
+
+    /// Online measurement-noise estimation of the ERMAKF family, used by the variants
+    /// eiakf, srmakf and ermakf (ekf ignores this section). Estimates are per satellite
+    /// and per observable (pseudo-range, pseudo-range rate).
+    section adaptive: AdaptiveConfig {
+        /// Window M of the redundant-measurement estimator: the number of second-order
+        /// mutual differences (eq. 18) averaged; trades smoothness against sharpness.
+        // Choice: a KDE or AR fit on fewer than 10 samples is noise (DESIGN.md pitfalls).
+        window_size_m: usize = 100,
+            unit "epochs", range Range::Count { min: 10, max: MAX_WINDOW_EPOCHS }, at_start;
+        /// Samples needed in a satellite's window before its estimate (and the KDE
+        /// verdict) is used; until then the fixed sigmas of gnss.* apply. At least
+        /// max(ar_max_order + 2, 10) and at most window_size_m.
+        min_samples: usize = 30,
+            unit "epochs", range Range::Count { min: 10, max: MAX_WINDOW_EPOCHS }, at_start;
+        /// Random weighting of the window (Dirichlet weights, eq. 19) against outliers.
+        /// Used by ermakf; srmakf always uses the plain mean (eq. 18).
+        random_weighting: bool = true, unit "", range ANY, at_start;
+        /// Seed of the random weights (replays are reproducible).
+        random_seed: u64 = 0, unit "", range ANY, at_start;
+        /// KDE credibility threshold: the newest difference is credible when the window's
+        /// kernel density there exceeds that of a Gaussian at this many standard
+        /// deviations (section 3.2).
+        kde_threshold: f64 = 3.0, unit "sigma", range THRESHOLD, at_start;
+        /// Consecutive non-credible epochs that declare the noise non-Gaussian (and
+        /// credible epochs that declare it Gaussian again).
+        kde_consecutive_epochs: usize = 3,
+            unit "epochs", range Range::Count { min: 1, max: MAX_WINDOW_EPOCHS }, at_start;
+        /// Highest order of the Burg AR model fitted in the non-Gaussian state (eqs.
+        /// 25-27).
+        // Choice: at most 100. Burg's recursion costs window x order per satellite and
+        // epoch, and an AR fit needs many more samples than its order (the window holds
+        // at most 1e4); the criteria pick orders below 10 on GNSS noise.
+        ar_max_order: usize = 5, unit "", range Range::Count { min: 1, max: 100 }, at_start;
+        /// Criterion choosing the AR order: aic (Akaike, as in the paper) or bic
+        /// (Schwarz).
+        ar_order_criterion: OrderCriterion = OrderCriterion::Aic, unit "", range ANY, at_start;
+        /// Floor of the eq. (29) denominator 1 - sum(a_i beta_i): caps the AR inflation of
+        /// the variance at 1/floor.
+        ar_denominator_floor: f64 = 0.1,
+            unit "", range Range::Within(Interval::closed(1e-3, 1.0)), at_start;
+        /// Innovation window of the eiakf (innovation-based) estimator.
+        innovation_window: usize = 50,
+            unit "epochs", range Range::Count { min: 10, max: MAX_WINDOW_EPOCHS }, at_start;
+        /// Significance level of the eiakf whiteness test of the innovations.
+        innovation_significance: f64 = 0.05,
+            unit "", range Range::Within(Interval::closed(1e-6, 0.5)), at_start;
+        /// Lower bound on an estimated pseudo-range 1-sigma.
+        pseudorange_sigma_min_m: f64 = 0.3, unit "m", range SIGMA, at_start;
+        /// Upper bound on an estimated pseudo-range 1-sigma (at least the lower one).
+        pseudorange_sigma_max_m: f64 = 150.0, unit "m", range SIGMA, at_start;
+        /// Lower bound on an estimated pseudo-range-rate 1-sigma.
+        pseudorange_rate_sigma_min_mps: f64 = 0.02, unit "m/s", range SIGMA, at_start;
+        /// Upper bound on an estimated pseudo-range-rate 1-sigma (at least the lower one).
+        pseudorange_rate_sigma_max_mps: f64 = 10.0, unit "m/s", range SIGMA, at_start;
+        /// Longest gap between two epochs of a satellite across which a mutual difference
+        /// is still formed; a longer gap restarts that satellite's window.
+        max_epoch_gap_s: f64 = 2.0,
+            unit "s", range Range::Within(Interval::closed(1e-3, 3600.0)), at_start;
+    }
+
+    /// Constants of the IARF paper's schemes (variants akf_all, akf_partial, iarf) and of
+    /// Ding's residual R (residual_akf) and Q scaling (filter.q_scaling). Other variants
+    /// ignore this section. All are dimensionless.
+    section robust: RobustConfig {
+        /// Adaptive factor alpha of the predicted-residual statistic dV (section 2.2):
+        /// two_segment = eq. (9), alpha = 1 for dV <= c, c/dV above; three_segment = eq.
+        /// (10), 1 below c0, (c0/dV)((c1-dV)/(c1-c0))^2 between, 0 above c1.
+        adaptive_factor_function: AdaptiveFactorKind = AdaptiveFactorKind::TwoSegment,
+            unit "", range ANY, at_start;
+        /// Threshold c of the two-segment factor; the paper gives 1.0-1.5 and uses 1.0.
+        adaptive_factor_c: f64 = 1.0, unit "", range THRESHOLD, at_start;
+        /// Threshold c0 of the three-segment factor; the paper gives 1.0-1.5.
+        adaptive_factor_c0: f64 = 1.0, unit "", range THRESHOLD, at_start;
+        /// Threshold c1 > c0 of the three-segment factor; the paper gives 3.0-8.5.
+        adaptive_factor_c1: f64 = 3.0, unit "", range THRESHOLD, at_start;
+        /// Floor of alpha: P-/alpha inflates the prior at most 1/floor times (the paper
+        /// lets alpha reach 0, an infinite prior).
+        alpha_floor: f64 = 0.01, unit "", range FRACTION, at_start;
+        /// Robust equivalent covariance of iarf (section 3): double_factor = the paper's
+        /// lambda_ii = 1 for |v| <= c, |v|/c above (v the standardized predicted
+        /// residual), lambda_ij = sqrt(lambda_ii lambda_jj), R_bar = lambda_ij R; igg3 =
+        /// Yang's IGG-III weights (k0, k1) in the same double-factor form.
+        equivalent_weight_function: EquivalentWeightKind = EquivalentWeightKind::DoubleFactor,
+            unit "", range ANY, at_start;
+        /// Threshold c of the double factor; the paper gives 1.0-1.5.
+        double_factor_c: f64 = 1.5, unit "", range THRESHOLD, at_start;
+        /// IGG-III threshold k0 (weight 1 below k0).
+        igg3_k0: f64 = 1.5, unit "", range THRESHOLD, at_start;
+        /// IGG-III threshold k1 > k0 (weight 0 above k1).
+        igg3_k1: f64 = 3.0, unit "", range THRESHOLD, at_start;
+        /// Largest variance inflation lambda_ii (a zero weight becomes this inflation, so
+        /// R_bar stays finite and positive definite).
+        max_variance_inflation: f64 = 1e6, unit "", range FACTOR_MAX, at_start;
+        /// Confidence of the Mahalanobis test M^2 <= chi2(confidence, dimension) that
+        /// decides whether akf_partial and iarf apply the adaptive factor; 1 - confidence
+        /// is the false-alarm rate on healthy epochs.
+        // Choice: a confidence below one half would raise alarms on most healthy epochs.
+        chi2_confidence: f64 = 0.95,
+            unit "", range Range::Within(Interval::below(0.5, 1.0)), at_start;
+        /// Window m of residual_akf (eq. 15): a satellite's (or the fix's) estimate is used
+        /// once its window is full; until then the nominal R.
+        // Choice: a second moment from fewer than 5 epochs is noise (spread above 60 %).
+        residual_window_epochs: usize = 64,
+            unit "epochs", range Range::Count { min: 5, max: MAX_WINDOW_EPOCHS }, at_start;
+        /// Window m of the Q-scaling factor alpha (eq. 19); Q is rescaled once per full
+        /// window.
+        q_window_epochs: usize = 64,
+            unit "epochs", range Range::Count { min: 5, max: MAX_WINDOW_EPOCHS }, at_start;
+        /// Lower bound on one window's alpha (Q changes by sqrt(alpha) per window).
+        q_alpha_min: f64 = 0.01, unit "", range FRACTION, at_start;
+        /// Upper bound on one window's alpha.
+        q_alpha_max: f64 = 100.0, unit "", range FACTOR_MAX, at_start;
+        /// Lower bound on the accumulated factor on the configured Q.
+        q_scale_min: f64 = 0.001, unit "", range FRACTION, at_start;
+        /// Upper bound on the accumulated factor on the configured Q.
+        q_scale_max: f64 = 1000.0, unit "", range FACTOR_MAX, at_start;
+    }
+
+    /// Start-up (alignment) and the initial 1-sigma of every state block.
+    section init: InitConfig {
+        /// Known initial heading of the body x axis, clockwise from true north (compass;
+        /// 0 = north, 90 = east; ENU yaw = 90 deg - heading). null = taken from the GNSS
+        /// velocity once the speed exceeds heading_min_speed_mps (heading is not
+        /// observable at rest).
+        heading_rad: Option<f64> ["heading_deg": Option<f64>] = None,
+            unit "deg", range Range::Within(Interval::closed(-360.0, 360.0)), at_start,
+            si Scale::to("rad", RAD_PER_DEG);
+        /// Speed above which the GNSS velocity gives the initial heading.
+        heading_min_speed_mps: f64 = 1.0,
+            unit "m/s", range Range::Within(Interval::above(0.0, 1e3)), at_start;
+        /// Accelerometer averaging at rest for the initial roll and pitch.
+        leveling_duration_s: f64 = 1.0,
+            unit "s", range Range::Within(Interval::closed(1e-3, 3600.0)), at_start;
+        /// Satellites needed for the single-point solution that starts the filter.
+        // Choice: at most 64. A single-point solution needs 4; no place on Earth sees much
+        // more than 60 satellites of all six systems at once, so a start that needs more
+        // would never happen (the error names this parameter instead of "nothing usable").
+        min_satellites: usize = 5,
+            unit "satellites", range Range::Count { min: 4, max: 64 }, at_start;
+        /// Initial 1-sigma of roll and pitch.
+        attitude_sigma_rad: f64 ["attitude_sigma_deg": f64] = 1.0,
+            unit "deg", range Range::Within(Interval::closed(1e-9, 180.0)), at_start,
+            si Scale::to("rad", RAD_PER_DEG);
+        /// Initial 1-sigma of heading.
+        heading_sigma_rad: f64 ["heading_sigma_deg": f64] = 5.0,
+            unit "deg", range Range::Within(Interval::closed(1e-9, 180.0)), at_start,
+            si Scale::to("rad", RAD_PER_DEG);
+        /// Initial 1-sigma of each velocity component.
+        velocity_sigma_mps: f64 = 0.5, unit "m/s", range SIGMA, at_start;
+        /// Initial 1-sigma of each position component.
+        position_sigma_m: f64 = 5.0, unit "m", range SIGMA, at_start;
+        /// Initial 1-sigma of the receiver clock bias c*dt_u.
+        clock_bias_sigma_m: f64 = 30.0, unit "m", range SIGMA, at_start;
+        /// Initial 1-sigma of the receiver clock drift c*dt_ru.
+        clock_drift_sigma_mps: f64 = 5.0, unit "m/s", range SIGMA, at_start;
+    }
+
+    /// Buffering and gaps of the input streams.
+    section engine: EngineConfig {
+        /// How far back a late GNSS epoch may reach into the IMU history.
+        // Choice: at most a minute: GNSS latency is well below a second, and the history
+        // is kept in memory (a minute of a 1 kHz IMU is 60,000 samples).
+        imu_buffer_s: f64 = 2.0,
+            unit "s", range Range::Within(Interval::closed(1e-3, 60.0)), at_start;
+        /// A larger gap between IMU samples is rejected (the filter coasts or
+        /// re-initialises).
+        // Choice: at least 1 ms (a 1 kHz IMU's period): a smaller limit rejects every
+        // sample and the filter never starts.
+        max_imu_gap_s: f64 = 1.0,
+            unit "s", range Range::Within(Interval::closed(1e-3, 60.0)), at_run_time;
+    }
+
+    /// What is published and where the local frame sits.
+    section output: OutputConfig {
+        /// Origin of the local ENU frame of the odometry: [latitude, longitude, height
+        /// above the WGS84 ellipsoid]. null = the first fix.
+        // Choice: heights from 10 km below the ellipsoid to 100 km above it (the edge of
+        // space); anything else is a unit or sign mistake.
+        datum: Option<Llh> ["datum_llh_deg_m": Option<[f64; 3]>] = None,
+            unit "[deg, deg, m]",
+            range Range::Components([
+                ("latitude", Interval::closed(-90.0, 90.0), "deg"),
+                ("longitude", Interval::closed(-180.0, 180.0), "deg"),
+                ("height", Interval::closed(-1e4, 1e5), "m"),
+            ]),
+            at_start, si LlhDegToPosition;
+        /// Output rate. 0 = every IMU sample.
+        // Choice: at most 10 kHz, above any IMU's rate.
+        rate_hz: f64 = 0.0,
+            unit "Hz", range Range::Within(Interval::closed(0.0, 1e4)), at_run_time;
+    }
+}
