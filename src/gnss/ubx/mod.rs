@@ -1,4 +1,5 @@
-//! u-blox UBX input, pure (bytes in, values out): framing with checksum verification,
+//! u-blox UBX input, pure (bytes in, values out): framing with checksum verification
+//! (of a whole log, or of a stream arriving in chunks),
 //! decoders for UBX-RXM-RAWX, UBX-RXM-SFRBX and UBX-NAV-PVT, navigation-message decoding
 //! (GPS/QZSS LNAV, Galileo I/NAV, BeiDou D1) into ephemerides, and the construction of a
 //! [`crate::gnss::GnssEpoch`] from RAWX and the ephemerides.
@@ -21,7 +22,9 @@ mod nav_error;
 mod nav_pvt;
 mod rawx;
 mod reader;
+mod scanner;
 mod sfrbx;
+mod stream;
 
 pub use crate::gnss::epoch_build::{preferred_signals, BuiltEpoch, EpochStats};
 pub use beidou_d1::{d1_subframe, decode_d1_ephemeris, D1Subframe};
@@ -40,4 +43,6 @@ pub use nav_error::NavDataError;
 pub use nav_pvt::{decode_nav_pvt, CarrierSolution, NavPvt};
 pub use rawx::{decode_rawx, RawMeasurement, RawX, TrackingStatus};
 pub use reader::{read_ubx_log, read_ubx_log_with, UbxLog, UbxLogStats};
+pub use scanner::{MAX_FRAME_LEN, MAX_PAYLOAD_LEN};
 pub use sfrbx::{decode_sfrbx, Sfrbx};
+pub use stream::UbxFramer;
