@@ -47,7 +47,7 @@ pub use message::{decode_message, UbxMessage};
 pub use nav_decoder::{NavDecoder, NavDecoderStats, NavUpdate};
 pub use nav_error::NavDataError;
 pub use nav_pvt::{decode_nav_pvt, CarrierSolution, NavPvt};
-pub use rawx::{decode_rawx, RawMeasurement, RawX, TrackingStatus};
+pub use rawx::{decode_rawx, RawMeasurement, RawX, RawxBlock, TrackingStatus};
 pub use reader::{read_ubx_log, read_ubx_log_with, UbxLog, UbxLogStats};
 pub use scanner::{MAX_FRAME_LEN, MAX_PAYLOAD_LEN};
 pub use sfrbx::{decode_sfrbx, Sfrbx};
