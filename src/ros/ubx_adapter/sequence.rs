@@ -14,6 +14,10 @@ const SAME_EPOCH_S: f64 = 1e-6;
 /// second at 10 Hz.
 pub const TIMELINE_CONFIRM_EPOCHS: u32 = 3;
 
+/// Choice: epochs of one new timeline follow each other within this (s), which covers
+/// measurement rates down to 0.1 Hz; scattered old epochs do not add up to a timeline.
+const TIMELINE_STEP_S: f64 = 10.0;
+
 /// What to do with an epoch.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Verdict {
@@ -53,7 +57,11 @@ impl EpochSequence {
             return Verdict::Next;
         }
         let run = match self.rewind {
-            Some((previous, n)) if t.seconds_since(&previous) >= SAME_EPOCH_S => n + 1,
+            Some((previous, n))
+                if (SAME_EPOCH_S..=TIMELINE_STEP_S).contains(&t.seconds_since(&previous)) =>
+            {
+                n + 1
+            }
             _ => 1,
         };
         if run >= TIMELINE_CONFIRM_EPOCHS {
@@ -79,8 +87,10 @@ mod tests {
         assert_eq!(s.judge(at(2048, 0.0)), Verdict::Next, "week rollover");
         assert_eq!(s.judge(at(2048, 0.0)), Verdict::Duplicate);
         assert_eq!(s.judge(at(2048, 0.1)), Verdict::Next);
-        // One stray epoch in the past is dropped, the timeline stays.
+        // Stray epochs in the past are dropped, the timeline stays.
         assert_eq!(s.judge(at(2047, 100.0)), Verdict::Backwards);
+        assert_eq!(s.judge(at(2047, 200.0)), Verdict::Backwards);
+        assert_eq!(s.judge(at(2047, 300.0)), Verdict::Backwards);
         assert_eq!(s.judge(at(2048, 0.2)), Verdict::Next);
         // A receiver clock reset 5 s back: taken on its third epoch.
         assert_eq!(s.judge(at(2047, 604_795.3)), Verdict::Backwards);
