@@ -4,7 +4,7 @@
 //!
 //! Input: the walk_0827 log as ublox_dgnss publishes it, with every satellite's
 //! subframes and measurement blocks also sent under three more satellite numbers (svId
-//! + 60, + 120, + 180), so that once the ephemerides are in an epoch uses ~30 satellites
+//! plus 60, 120 and 180), so that once the ephemerides are in an epoch uses ~30 satellites
 //! (dual-frequency, ionosphere-free: ~70 signals each), and the log played `LOOPS`
 //! times, one GPS week apart. Each epoch is timed from its CDR payload to the CDR
 //! payload of its GnssMeasurements (decode, adapter, encode), as the node would.

@@ -346,30 +346,27 @@ fn duplicated_epochs_a_clock_running_back_and_a_1024_week_rollover() {
 
     // After the run, an old epoch again (dropped), then the receiver's time 10 s back
     // for good: followed from the third such epoch on.
-    let mut tail: Vec<(u64, DriverMessage)> = Vec::new();
     let (last_ns, _) = rawx.last().unwrap();
-    tail.push((
+    // The last five epochs again, changed by `change`, received from `after_ns` on.
+    let last_five = |after_ns: u64, change: &dyn Fn(&mut UbxRxmRawx)| {
+        rawx[rawx.len() - 5..]
+            .iter()
+            .enumerate()
+            .map(|(k, (_, r))| {
+                let mut r = r.clone();
+                change(&mut r);
+                (after_ns + k as u64 * 250_000_000, DriverMessage::Rawx(r))
+            })
+            .collect::<Vec<_>>()
+    };
+    let mut tail = vec![(
         last_ns + 250_000_000,
         DriverMessage::Rawx(rawx[300].1.clone()),
-    ));
-    for k in 0..5 {
-        let (_, mut r) = rawx[rawx.len() - 5 + k].clone();
-        r.rcv_tow -= 10.0;
-        tail.push((
-            last_ns + 500_000_000 + k as u64 * 250_000_000,
-            DriverMessage::Rawx(r),
-        ));
-    }
+    )];
+    tail.extend(last_five(last_ns + 500_000_000, &|r| r.rcv_tow -= 10.0));
     // The receiver's week 1024 weeks back (a 10-bit rollover bug): no ephemeris is valid
     // then, nothing is published.
-    for k in 0..5 {
-        let (_, mut r) = rawx[rawx.len() - 5 + k].clone();
-        r.week -= 1024;
-        tail.push((
-            last_ns + 2_000_000_000 + k as u64 * 250_000_000,
-            DriverMessage::Rawx(r),
-        ));
-    }
+    tail.extend(last_five(last_ns + 2_000_000_000, &|r| r.week -= 1024));
     let mut all = messages.clone();
     all.extend(tail);
     let (out, adapter) = run(&all);

@@ -213,6 +213,26 @@ fn driver_messages_convert_to_the_as_received_measurements() {
     write_robot_bag(&robot, items);
     let out = dir.path().join("dgnss_converted.mcap");
     let summary = convert_robot_bag(&robot, &out);
+    // The command line gives the same bag.
+    let cli_out = dir.path().join("dgnss_cli.mcap");
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_gnss_ins"))
+        .args(["convert", "--bag"])
+        .arg(&robot)
+        .args(["--rawx-topic", "/ubx_rxm_rawx", "--imu-topic", "/imu/data"])
+        .args(["--time-base", "gnss", "--out"])
+        .arg(&cli_out)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("UBXRxmRawx/UBXRxmSfrbx messages"),
+        "{stderr}"
+    );
+    assert_eq!(
+        std::fs::read(&cli_out).unwrap(),
+        std::fs::read(&out).unwrap()
+    );
     check_against_reference(
         &out,
         &summary,

@@ -1,5 +1,6 @@
 //! `gnss_ins convert`: a u-blox UBX log, an IMU CSV and optionally a reference trajectory
-//! written as a rosbag2 MCAP bag of this package's messages.
+//! written as a rosbag2 MCAP bag of this package's messages; or a robot's bag with the
+//! u-blox drivers' raw GNSS and its IMU ([`super::convert_bag`]).
 //!
 //! Topics (the names `simulate` uses, so `replay` and `compare` read both alike):
 //! - `/gnss/measurements`: GnssMeasurements, one per UBX-RXM-RAWX epoch with satellites,

@@ -86,12 +86,12 @@ impl UbxAdapterCounts {
         ];
         let (s, f, n) = (&self.satellites, &self.frames, &self.nav.decoder);
         let decoding = [
-            ("satellites_used", s.used),
-            ("satellites_no_ephemeris", s.no_ephemeris),
-            ("satellites_single_frequency", s.single_frequency),
-            ("satellites_duplicate_signals", s.duplicate_signals),
-            ("satellites_unsupported", s.unsupported),
-            ("satellites_ephemeris_errors", s.ephemeris_errors),
+            ("satellite_epochs_used", s.used),
+            ("satellite_epochs_no_ephemeris", s.no_ephemeris),
+            ("satellite_epochs_single_frequency", s.single_frequency),
+            ("satellite_epochs_duplicate_signals", s.duplicate_signals),
+            ("satellite_epochs_unsupported", s.unsupported),
+            ("satellite_epochs_ephemeris_errors", s.ephemeris_errors),
             ("frames_bad_checksum", f.bad_checksum),
             ("frames_truncated", f.truncated),
             ("frames_oversized", f.oversized),

@@ -355,3 +355,75 @@ fn key_value(key: &str, value: &str) -> KeyValue {
         value: value.to_owned(),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ros::msg::{Header, RawxData, RecStat, TrkStat};
+
+    /// A RAWX of one GPS L1 signal at `tow_s`, received 40 ms later (UTC stamp).
+    fn rawx(tow_s: f64) -> UbxRxmRawx {
+        let gpst_s = 315_964_800.0 + 2381.0 * 604_800.0 + tow_s;
+        UbxRxmRawx {
+            header: Header {
+                stamp: seconds_to_time(gpst_s - 18.0 + 0.04).unwrap(),
+                frame_id: "ubx".to_owned(),
+            },
+            rcv_tow: tow_s,
+            week: 2381,
+            leap_s: 18,
+            num_meas: 1,
+            rec_stat: RecStat {
+                leap_sec: true,
+                clk_reset: false,
+            },
+            version: 1,
+            rawx_data: vec![RawxData {
+                pr_mes: 2.2e7,
+                gnss_id: 0,
+                sv_id: 5,
+                trk_stat: TrkStat {
+                    pr_valid: true,
+                    ..TrkStat::default()
+                },
+                ..RawxData::default()
+            }],
+        }
+    }
+
+    fn value(status: &DiagnosticStatus, key: &str) -> String {
+        status
+            .values
+            .iter()
+            .find(|kv| kv.key == key)
+            .map(|kv| kv.value.clone())
+            .unwrap_or_default()
+    }
+
+    #[test]
+    fn diagnostics_warn_while_no_epoch_is_usable_and_report_the_clocks() {
+        let mut adapter = UbxAdapter::new(UbxAdapterParams::default()).unwrap();
+        let status = adapter.diagnostics("ubx");
+        assert_eq!(status.level, DiagnosticStatus::OK);
+        assert_eq!(value(&status, "receiver_to_host_offset_s"), "unknown");
+        for k in 0..3 {
+            let msg = rawx(408_000.0 + f64::from(k) * 0.25);
+            let arrival_s = time_to_seconds(&msg.header.stamp).unwrap();
+            assert_eq!(adapter.on_rawx(&msg, arrival_s), None, "no ephemeris");
+        }
+        let status = adapter.diagnostics("ubx");
+        assert_eq!(status.level, DiagnosticStatus::WARN);
+        assert!(status.message.contains("no epoch with a usable satellite"));
+        assert_eq!(value(&status, "empty_epochs"), "3");
+        assert_eq!(value(&status, "satellite_epochs_no_ephemeris"), "3");
+        assert_eq!(value(&status, "receiver_to_host_offset_s"), "0.0400");
+        assert_eq!(value(&status, "leap_seconds"), "18 (receiver)");
+        assert_eq!(value(&status, "imu_gnss_skew_s"), "unknown");
+        // A count that disagrees with the array is malformed, not used.
+        let mut bad = rawx(408_001.0);
+        bad.num_meas = 2;
+        assert_eq!(adapter.on_rawx(&bad, 0.0), None);
+        assert_eq!(adapter.counts().malformed, 1);
+        assert_eq!(adapter.counts().empty_epochs, 3);
+    }
+}
