@@ -101,3 +101,51 @@ impl BroadcastNav {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::gps_lnav::tests::lnav_words;
+    use super::*;
+
+    /// GPS subframe 4, page 18 (SV ID 56): α0..α3 = 11, 8, −4, −1 and β0..β3 = 88, 0,
+    /// −3, −1 (8-bit codes).
+    fn page_18() -> Vec<u32> {
+        lnav_words([
+            0x8B_0000,
+            (68_000 << 7) | (4 << 2),
+            (1 << 22) | (56 << 16) | (0x0B << 8) | 0x08,
+            (0xFC << 16) | (0xFF << 8) | 0x58,
+            (0xFD << 8) | 0xFF, // β1 = 0
+            0,
+            0,
+            0,
+            0,
+            0,
+        ])
+    }
+
+    #[test]
+    fn klobuchar_of_subframe_4_page_18_reaches_the_next_epochs() {
+        let mut nav = BroadcastNav::new();
+        let raw = |tow_s| RawX::new(tow_s, 2381, 18, 1, 1, Vec::new());
+        let mode = IonosphereMode::Broadcast;
+        assert_eq!(nav.on_rawx(&raw(408_000.0), mode).epoch.klobuchar, None);
+        nav.on_sfrbx(Sfrbx {
+            gnss_id: 0,
+            sv_id: 5,
+            sig_id: 0,
+            freq_id: 0,
+            channel: 3,
+            version: 2,
+            words: page_18(),
+        });
+        let k = nav.on_rawx(&raw(408_000.25), mode).epoch.klobuchar.unwrap();
+        let p = |e: i32| 2f64.powi(e);
+        assert_eq!(
+            k.alpha,
+            [11.0 * p(-30), 8.0 * p(-27), -4.0 * p(-24), -p(-24)]
+        );
+        assert_eq!(k.beta, [88.0 * p(11), 0.0, -3.0 * p(16), -p(16)]);
+        assert_eq!(nav.stats().decoder.accepted, 1);
+    }
+}

@@ -187,7 +187,7 @@ pub fn decode_lnav_klobuchar(sf4: &Bits) -> Option<Klobuchar> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::gnss::Constellation;
 
@@ -207,23 +207,26 @@ mod tests {
         w
     }
 
+    /// The u-blox words of a subframe of ten 24-bit data words, parity chained.
+    pub(crate) fn lnav_words(data: [u32; LNAV_WORDS]) -> Vec<u32> {
+        let (mut d29, mut d30) = (0, 0);
+        data.iter()
+            .map(|&d| {
+                let w = encode(d, d29, d30);
+                d29 = (w >> 1) & 1;
+                d30 = w & 1;
+                w
+            })
+            .collect()
+    }
+
     #[test]
     fn parity_accepts_encoded_words_and_rejects_a_flipped_bit() {
-        let mut words = Vec::new();
-        let (mut d29, mut d30) = (0, 0);
-        for k in 0..10u32 {
-            let d = if k == 0 {
-                0x8B0000
-            } else if k == 1 {
-                2 << 2
-            } else {
-                0x5A5A5A ^ k
-            };
-            let w = encode(d, d29, d30);
-            d29 = (w >> 1) & 1;
-            d30 = w & 1;
-            words.push(w);
-        }
+        let mut words = lnav_words(std::array::from_fn(|k| match k {
+            0 => 0x8B0000,
+            1 => 2 << 2,
+            _ => 0x5A5A5A ^ k as u32,
+        }));
         let sf = lnav_subframe(G01, &words).unwrap();
         assert_eq!(sf.id, 2);
         assert_eq!(sf.data.u(24 * 4, 24), Some(u64::from(0x5A5A5A ^ 4u32)));
