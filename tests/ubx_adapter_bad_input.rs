@@ -2,9 +2,9 @@
 //! u-blox drivers publish it: random bytes and truncated frames in the stream, bad
 //! checksums, SFRBX with a wrong word count or parity, a GPS clock subframe whose IODC
 //! does not match the IODE of its orbit, RAWX with 0 and 200 signals, GPS week rollovers,
-//! a receiver clock running backwards, duplicated epochs. Each is counted, nothing
-//! panics, and nothing published differs from the clean run: an epoch is left out, or a
-//! satellite, but never changed.
+//! a receiver clock running backwards, a stray epoch ahead, duplicated epochs. Each is
+//! counted, nothing panics, and nothing published differs from the clean run: an epoch
+//! is left out, or a satellite, but never changed.
 
 mod ubx_robot_support;
 
@@ -344,8 +344,9 @@ fn duplicated_epochs_a_clock_running_back_and_a_1024_week_rollover() {
     assert_eq!(out.len(), reference.len());
     assert_never_wrong(&out, &reference);
 
-    // After the run, an old epoch again (dropped), then the receiver's time 10 s back
-    // for good: followed from the third such epoch on.
+    // After the run, a stray epoch an hour ahead (within the ephemerides' validity) and
+    // an old epoch again (both dropped), then the receiver's time 10 s back for good:
+    // followed from the third such epoch on.
     let (last_ns, _) = rawx.last().unwrap();
     // The last five epochs again, changed by `change`, received from `after_ns` on.
     let last_five = |after_ns: u64, change: &dyn Fn(&mut UbxRxmRawx)| {
@@ -359,10 +360,15 @@ fn duplicated_epochs_a_clock_running_back_and_a_1024_week_rollover() {
             })
             .collect::<Vec<_>>()
     };
-    let mut tail = vec![(
-        last_ns + 250_000_000,
-        DriverMessage::Rawx(rawx[300].1.clone()),
-    )];
+    let mut ahead = rawx[rawx.len() - 1].1.clone();
+    ahead.rcv_tow += 3_600.0;
+    let mut tail = vec![
+        (last_ns + 100_000_000, DriverMessage::Rawx(ahead)),
+        (
+            last_ns + 250_000_000,
+            DriverMessage::Rawx(rawx[300].1.clone()),
+        ),
+    ];
     tail.extend(last_five(last_ns + 500_000_000, &|r| r.rcv_tow -= 10.0));
     // The receiver's week 1024 weeks back (a 10-bit rollover bug): no ephemeris is valid
     // then, nothing is published.
@@ -372,6 +378,7 @@ fn duplicated_epochs_a_clock_running_back_and_a_1024_week_rollover() {
     let (out, adapter) = run(&all);
     let c = adapter.counts();
     println!("{c:?}");
+    assert_eq!(c.time_jumps_ahead, 1);
     assert_eq!(c.time_backwards, 1 + 2 + 2);
     assert_eq!(c.timeline_restarts, 2);
     // The reset epochs are published at their new times (3 of the 5: after the restart).

@@ -27,7 +27,10 @@ pub struct UbxAdapterCounts {
     pub duplicate_epochs: u64,
     /// RAWX before the last one used (dropped; receiver clock reset or a stray epoch).
     pub time_backwards: u64,
-    /// Receiver timelines taken after a sustained jump back.
+    /// RAWX more than 10 s after the last one used (dropped; a stray epoch, or the first
+    /// ones after an outage).
+    pub time_jumps_ahead: u64,
+    /// Receiver timelines taken after a sustained jump.
     pub timeline_restarts: u64,
     /// Epochs whose leap seconds came from the parameter (receiver's not valid).
     pub leap_seconds_from_parameter: u64,
@@ -75,6 +78,7 @@ impl UbxAdapterCounts {
             ("invalid_time", self.invalid_time),
             ("duplicate_epochs", self.duplicate_epochs),
             ("time_backwards", self.time_backwards),
+            ("time_jumps_ahead", self.time_jumps_ahead),
             ("timeline_restarts", self.timeline_restarts),
             (
                 "leap_seconds_from_parameter",

@@ -14,7 +14,7 @@
 //! Every input is checked and what is unusable is counted, never guessed: undecodable
 //! and malformed messages, stream garbage (bad checksums, truncated and oversized
 //! frames), subframes with a wrong word count, parity or issue of data, epochs with an
-//! invalid, repeated or earlier receiver time (see [`sequence`]), satellites with
+//! invalid, repeated, earlier or far later receiver time (see [`sequence`]), satellites with
 //! duplicated signals. The time base and the clock check are in [`clock_check`].
 
 mod clock_check;
@@ -25,11 +25,9 @@ mod sequence;
 
 pub use clock_check::{ClockReport, LeapSource};
 pub use counts::UbxAdapterCounts;
-pub use inbound::{rawx_of, sfrbx_of, CountMismatch};
 pub use params::{
     TimeBase, UbxAdapterParamError, UbxAdapterParams, DEFAULT_HOST_LATENCY_S, MAX_LEAP_SECONDS,
 };
-pub use sequence::TIMELINE_CONFIRM_EPOCHS;
 
 use crate::gnss::ephemeris::{GpsTime, SECONDS_PER_WEEK};
 use crate::gnss::ubx::{decode_message, BroadcastNav, RawX, UbxFramer, UbxMessage};
@@ -41,6 +39,7 @@ use crate::ros::node::log_limit::LogLimiter;
 use crate::ros::outbound;
 
 use clock_check::ClockCheck;
+use inbound::{rawx_of, sfrbx_of};
 use sequence::{EpochSequence, Verdict};
 
 /// See the module doc.
@@ -199,10 +198,22 @@ impl UbxAdapter {
             Verdict::NewTimeline => {
                 self.counts.timeline_restarts += 1;
                 log::warn!(
-                    "receiver time jumped back to week {} TOW {:.3} s and went on: following it",
+                    "receiver time jumped to week {} TOW {:.3} s and went on: following it",
                     t.week,
                     t.tow_s
                 );
+            }
+            Verdict::Ahead => {
+                self.counts.time_jumps_ahead += 1;
+                self.log.warn(
+                    "time_jump_ahead",
+                    &format!(
+                        "RAWX at week {} TOW {:.3} s is far after the last epoch used: dropped \
+                         until the next ones confirm it",
+                        t.week, t.tow_s
+                    ),
+                );
+                return None;
             }
             Verdict::Duplicate => {
                 self.counts.duplicate_epochs += 1;

@@ -1,5 +1,9 @@
 //! The order of receiver epochs: each RAWX's receiver time (GPS week and time of week,
-//! so a week rollover is just the next second) must follow the last accepted one.
+//! so a week rollover is just the next second) must follow the last accepted one, within
+//! [`TIMELINE_STEP_S`]. An epoch before it, or further after it, is a jump: dropped until
+//! [`TIMELINE_CONFIRM_EPOCHS`] epochs in a row follow the new time, which is then taken
+//! (a receiver clock reset, a restart after an outage); a stray epoch alone is never
+//! used, so one forged or corrupt time cannot move the satellites to another instant.
 
 use crate::gnss::ephemeris::GpsTime;
 
@@ -8,15 +12,14 @@ use crate::gnss::ephemeris::GpsTime;
 /// far below that and far above the f64 resolution of a time of week (0.1 ns).
 const SAME_EPOCH_S: f64 = 1e-6;
 
-/// Choice: after a receiver clock reset (or a stray epoch from the future), the new
-/// timeline is taken once this many epochs in a row have followed it; one outlying
-/// epoch alone never moves the timeline, a sustained jump does within a fraction of a
-/// second at 10 Hz.
+/// Choice: after a jump, the new timeline is taken once this many epochs in a row have
+/// followed it; one outlying epoch alone never moves the timeline, a sustained jump does
+/// within a fraction of a second at 10 Hz (the price: two epochs after an outage).
 pub const TIMELINE_CONFIRM_EPOCHS: u32 = 3;
 
-/// Choice: epochs of one new timeline follow each other within this (s), which covers
-/// measurement rates down to 0.1 Hz; scattered old epochs do not add up to a timeline.
-const TIMELINE_STEP_S: f64 = 10.0;
+/// Choice: consecutive epochs are at most this far apart (s), which covers measurement
+/// rates down to 0.1 Hz; beyond it the receiver time jumped (or the receiver was silent).
+pub const TIMELINE_STEP_S: f64 = 10.0;
 
 /// What to do with an epoch.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -29,14 +32,17 @@ pub enum Verdict {
     Duplicate,
     /// Before the last accepted epoch, not (yet) a confirmed new timeline: drop it.
     Backwards,
+    /// More than [`TIMELINE_STEP_S`] after the last accepted epoch, not (yet) a confirmed
+    /// new timeline: drop it.
+    Ahead,
 }
 
 /// The timeline of accepted epochs.
 #[derive(Debug, Clone, Default)]
 pub struct EpochSequence {
     last: Option<GpsTime>,
-    /// Epochs in a row after a jump back: the latest one's time, and how many.
-    rewind: Option<(GpsTime, u32)>,
+    /// Epochs in a row after a jump: the latest one's time, and how many.
+    jump: Option<(GpsTime, u32)>,
 }
 
 impl EpochSequence {
@@ -51,12 +57,12 @@ impl EpochSequence {
         if dt_s.abs() < SAME_EPOCH_S {
             return Verdict::Duplicate;
         }
-        if dt_s > 0.0 {
+        if dt_s > 0.0 && dt_s <= TIMELINE_STEP_S {
             self.last = Some(t);
-            self.rewind = None;
+            self.jump = None;
             return Verdict::Next;
         }
-        let run = match self.rewind {
+        let run = match self.jump {
             Some((previous, n))
                 if (SAME_EPOCH_S..=TIMELINE_STEP_S).contains(&t.seconds_since(&previous)) =>
             {
@@ -66,11 +72,15 @@ impl EpochSequence {
         };
         if run >= TIMELINE_CONFIRM_EPOCHS {
             self.last = Some(t);
-            self.rewind = None;
+            self.jump = None;
             Verdict::NewTimeline
         } else {
-            self.rewind = Some((t, run));
-            Verdict::Backwards
+            self.jump = Some((t, run));
+            if dt_s < 0.0 {
+                Verdict::Backwards
+            } else {
+                Verdict::Ahead
+            }
         }
     }
 }
@@ -97,5 +107,12 @@ mod tests {
         assert_eq!(s.judge(at(2047, 604_795.4)), Verdict::Backwards);
         assert_eq!(s.judge(at(2047, 604_795.5)), Verdict::NewTimeline);
         assert_eq!(s.judge(at(2047, 604_795.6)), Verdict::Next);
+        // A stray epoch an hour ahead is dropped; a receiver back after a 60 s outage is
+        // followed from its third epoch.
+        assert_eq!(s.judge(at(2048, 3_000.0)), Verdict::Ahead);
+        assert_eq!(s.judge(at(2047, 604_795.7)), Verdict::Next);
+        assert_eq!(s.judge(at(2048, 55.0)), Verdict::Ahead);
+        assert_eq!(s.judge(at(2048, 55.1)), Verdict::Ahead);
+        assert_eq!(s.judge(at(2048, 55.2)), Verdict::NewTimeline);
     }
 }
