@@ -14,8 +14,8 @@
 //! Every input is checked and what is unusable is counted, never guessed: undecodable
 //! and malformed messages, stream garbage (bad checksums, truncated and oversized
 //! frames), subframes with a wrong word count, parity or issue of data, epochs with an
-//! invalid, repeated, earlier or far later receiver time (see [`sequence`]), satellites with
-//! duplicated signals. The time base and the clock check are in [`clock_check`].
+//! invalid, repeated, earlier or far later receiver time (see `sequence.rs`), satellites
+//! with duplicated signals. The time base and the clock check are in `clock_check.rs`.
 
 mod clock_check;
 mod counts;
