@@ -367,6 +367,102 @@ fn noise_estimates_match_rosbags() {
     check("noise_estimates", &noise_estimates(), false);
 }
 
+fn ubx_rxm_rawx() -> UbxRxmRawx {
+    UbxRxmRawx {
+        header: header(1_756_402_257, 31_000_123, "ubx"),
+        rcv_tow: 408_657.001,
+        week: 2381,
+        leap_s: -18,
+        num_meas: 2,
+        rec_stat: RecStat {
+            leap_sec: true,
+            clk_reset: false,
+        },
+        version: 1,
+        rawx_data: vec![
+            RawxData {
+                pr_mes: 21_456_789.125,
+                cp_mes: -112_752_345.5,
+                do_mes: -1234.5,
+                gnss_id: 0,
+                sv_id: 32,
+                sig_id: 0,
+                freq_id: 7,
+                locktime: 64_500,
+                c_no: 45,
+                pr_stdev: 0x15,
+                cp_stdev: 3,
+                do_stdev: 7,
+                trk_stat: TrkStat {
+                    pr_valid: true,
+                    cp_valid: false,
+                    half_cyc: true,
+                    sub_half_cyc: false,
+                },
+            },
+            RawxData {
+                pr_mes: 23_987_654.5,
+                cp_mes: NAN,
+                do_mes: 2.25,
+                gnss_id: 3,
+                sv_id: 44,
+                sig_id: 4,
+                freq_id: 0,
+                locktime: 1,
+                c_no: 31,
+                pr_stdev: 9,
+                cp_stdev: 15,
+                do_stdev: 0,
+                trk_stat: TrkStat {
+                    pr_valid: false,
+                    cp_valid: true,
+                    half_cyc: false,
+                    sub_half_cyc: true,
+                },
+            },
+        ],
+    }
+}
+
+fn ubx_rxm_sfrbx() -> UbxRxmSfrbx {
+    UbxRxmSfrbx {
+        header: header(1_756_402_257, 5, "ubx"),
+        gnss_id: 2,
+        sv_id: 7,
+        sig_id: 1,
+        freq_id: 0,
+        num_words: 3,
+        chn: 17,
+        version: 2,
+        dwrd: vec![0x8B00_0001, 0xFFFF_FFFF, 0x0000_2A00],
+    }
+}
+
+fn uint8_multi_array() -> UInt8MultiArray {
+    UInt8MultiArray {
+        layout: MultiArrayLayout {
+            dim: vec![MultiArrayDimension {
+                label: "raw_data_stream".to_string(),
+                size: 7,
+                stride: 1,
+            }],
+            data_offset: 0,
+        },
+        data: vec![0xB5, 0x62, 0x02, 0x15, 0x10, 0x00, 0xFF],
+    }
+}
+
+#[test]
+fn ublox_driver_messages_match_rosbags() {
+    check("ubx_rxm_rawx", &ubx_rxm_rawx(), true);
+    check("ubx_rxm_sfrbx", &ubx_rxm_sfrbx(), false);
+}
+
+#[test]
+fn uint8_multi_array_matches_rosbags() {
+    check("uint8_multi_array", &uint8_multi_array(), false);
+}
+
 #[test]
 fn gnss_fixture_converts_to_the_core_epoch() {
     let msg: GnssMeasurements = decode(&fixture("gnss_measurements.cdr")).unwrap();
@@ -425,6 +521,15 @@ fn type_names_follow_ros_2_conventions() {
     assert!(NOISE_ESTIMATES_MSG.contains("SatelliteNoise[] satellites"));
     assert!(SATELLITE_MEASUREMENT_MSG.contains("uint8 GPS=1"));
     assert!(SATELLITE_NOISE_MSG.contains("uint8 REJECTION_MAHALANOBIS=6"));
+    assert_eq!(UbxRxmRawx::TYPE_NAME, "ublox_ubx_msgs/msg/UBXRxmRawx");
+    assert_eq!(
+        UbxRxmSfrbx::DDS_TYPE_NAME,
+        "ublox_ubx_msgs::msg::dds_::UBXRxmSfrbx_"
+    );
+    assert_eq!(
+        UInt8MultiArray::DDS_TYPE_NAME,
+        "std_msgs::msg::dds_::UInt8MultiArray_"
+    );
 }
 
 #[test]
@@ -467,6 +572,9 @@ fn truncated_payloads_are_errors() {
     all_prefixes_fail::<TwistWithCovarianceStamped>("twist_with_covariance_stamped.cdr");
     all_prefixes_fail::<GnssMeasurements>("gnss_measurements.cdr");
     all_prefixes_fail::<NoiseEstimates>("noise_estimates.cdr");
+    all_prefixes_fail::<UbxRxmRawx>("ubx_rxm_rawx.cdr");
+    all_prefixes_fail::<UbxRxmSfrbx>("ubx_rxm_sfrbx.cdr");
+    all_prefixes_fail::<UInt8MultiArray>("uint8_multi_array.cdr");
 }
 
 #[test]

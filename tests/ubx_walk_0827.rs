@@ -40,7 +40,14 @@ fn log_decodes_without_loss() {
     assert_eq!(s.frames.truncated, 0);
     assert_eq!((s.rawx, s.sfrbx, s.nav_pvt), (536, 2328, 536));
     assert_eq!(s.decode_errors, 0);
-    assert_eq!(s.nav.rejected, 0, "parity/BCH/CRC failures on a clean log");
+    assert_eq!(
+        s.nav.decoder.rejected, 0,
+        "parity/BCH/CRC failures on a clean log"
+    );
+    assert_eq!(
+        s.nav.decoder.issue_mismatch, 0,
+        "no upload changes in 134 s"
+    );
     let count = |c| {
         log.store
             .satellites()

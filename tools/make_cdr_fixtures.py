@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Writes tests/data/cdr/*.cdr: one ROS 2 CDR payload per message type, serialized by
 the independent pure-Python `rosbags` library (ROS 2 Jazzy type store plus this
-package's msg/ definitions). tests/cdr_fixtures.rs builds the same values in Rust and
+package's msg/ definitions and the u-blox driver's ublox_ubx_msgs definitions below). tests/cdr_fixtures.rs builds the same values in Rust and
 checks that our encoder reproduces these bytes exactly and our decoder reads them back.
 
 Usage (from the crate root, in a throw-away virtual environment outside the repo):
@@ -26,14 +26,77 @@ PACKAGE = "adaptive_gnss_ins"
 OWN_MESSAGES = ["SatelliteMeasurement", "GnssMeasurements", "SatelliteNoise", "NoiseEstimates"]
 NAN = float("nan")
 
+# The u-blox ROS 2 driver's message definitions, as in its repository
+# (github.com/aussierobots/ublox_dgnss, ublox_ubx_msgs/msg/, commit 67178ed36dbb): the
+# reference our src/ros/msg/ublox.rs structs are checked against.
+UBLOX_MESSAGES = {
+    "RecStat": """
+bool leap_sec       # Leap seconds have been determined
+bool clk_reset      # Clock reset applied
+""",
+    "TrkStat": """
+bool pr_valid       # Pseudorange valid
+bool cp_valid       # Carrier phase valid
+bool half_cyc       # Half cycle valid
+bool sub_half_cyc   # Half cycle subtracted from phase
+""",
+    "RawxData": """
+float64 pr_mes      # m - Pseudorange measurement
+float64 cp_mes      # cycles - Carrier phase measurement
+float32 do_mes      # Hz - Doppler measurement
+uint8 gnss_id       # GNSS identifier
+uint8 sv_id         # Satellite identifier
+uint8 sig_id        # Signal identifier
+uint8 freq_id       # Frequency slot for GLONASS
+uint16 locktime     # ms - Carrier phase locktime counter
+uint8 c_no          # dBHz - Carrier-to-noise density ratio
+uint8 pr_stdev      # 0.01*2^n m - Estimated pseudorange standard deviation
+uint8 cp_stdev      # 0.004 cycles - Estimated carrier phase standard deviation
+uint8 do_stdev      # 0.002*2^n Hz - Estimated Doppler standard deviation
+TrkStat trk_stat      # Tracking status bitfield
+# uint8 reserved1     # Reserved
+""",
+    "UBXRxmRawx": """
+std_msgs/Header header  # Header timestamp should be acquisition time
+
+# Fields
+float64 rcv_tow      # s - Measurement time of week
+uint16 week          # weeks - GPS week number
+int8 leap_s          # s - GPS leap seconds
+uint8 num_meas       # Number of measurements
+RecStat rec_stat       # Receiver tracking status bitfield
+uint8 version        # Message version
+# uint8[2] reserved0   # Reserved
+
+RawxData[] rawx_data # Repeated group of data for each satellite
+""",
+    "UBXRxmSfrbx": """
+std_msgs/Header header  # Header timestamp should be acquisition time
+
+# Fields
+uint8 gnss_id       # GNSS identifier (see Satellite Numbering)
+uint8 sv_id         # Satellite identifier (see Satellite Numbering)
+uint8 sig_id        # Signal identifier (see Signal Identifiers)
+uint8 freq_id       # Only used for GLONASS: frequency slot + 7 (range 0 to 13)
+uint8 num_words     # Number of data words contained in this message (up to 16)
+uint8 chn           # Tracking channel number the message was received on
+uint8 version       # Message version (0x02 for this version)
+
+uint32[] dwrd       # Data words (numWords entries)
+""",
+}
+
 
 def make_typestore():
-    """ROS 2 Jazzy types plus this package's messages read from msg/."""
+    """ROS 2 Jazzy types plus this package's messages read from msg/ and the u-blox
+    driver's."""
     store = get_typestore(Stores.ROS2_JAZZY)
     types = {}
     for name in OWN_MESSAGES:
         text = (MSG_DIR / f"{name}.msg").read_text(encoding="utf-8")
         types.update(get_types_from_msg(text, f"{PACKAGE}/msg/{name}"))
+    for name, text in UBLOX_MESSAGES.items():
+        types.update(get_types_from_msg(text, f"ublox_ubx_msgs/msg/{name}"))
     store.register(types)
     return store
 
@@ -232,6 +295,71 @@ def build_messages(ts):
         nis=7.75,
     )
 
+    U = "ublox_ubx_msgs/msg/"
+    TrkStat = T[U + "TrkStat"]
+    RawxData = T[U + "RawxData"]
+    ubx_rxm_rawx = T[U + "UBXRxmRawx"](
+        header=Header(stamp=Time(sec=1_756_402_257, nanosec=31_000_123), frame_id="ubx"),
+        rcv_tow=408_657.001,
+        week=2381,
+        leap_s=-18,
+        num_meas=2,
+        rec_stat=T[U + "RecStat"](leap_sec=True, clk_reset=False),
+        version=1,
+        rawx_data=[
+            RawxData(
+                pr_mes=21_456_789.125,
+                cp_mes=-112_752_345.5,
+                do_mes=-1234.5,
+                gnss_id=0,
+                sv_id=32,
+                sig_id=0,
+                freq_id=7,
+                locktime=64_500,
+                c_no=45,
+                pr_stdev=0x15,
+                cp_stdev=3,
+                do_stdev=7,
+                trk_stat=TrkStat(pr_valid=True, cp_valid=False, half_cyc=True, sub_half_cyc=False),
+            ),
+            RawxData(
+                pr_mes=23_987_654.5,
+                cp_mes=NAN,
+                do_mes=2.25,
+                gnss_id=3,
+                sv_id=44,
+                sig_id=4,
+                freq_id=0,
+                locktime=1,
+                c_no=31,
+                pr_stdev=9,
+                cp_stdev=15,
+                do_stdev=0,
+                trk_stat=TrkStat(pr_valid=False, cp_valid=True, half_cyc=False, sub_half_cyc=True),
+            ),
+        ],
+    )
+    ubx_rxm_sfrbx = T[U + "UBXRxmSfrbx"](
+        header=Header(stamp=Time(sec=1_756_402_257, nanosec=5), frame_id="ubx"),
+        gnss_id=2,
+        sv_id=7,
+        sig_id=1,
+        freq_id=0,
+        num_words=3,
+        chn=17,
+        version=2,
+        dwrd=np.array([0x8B00_0001, 0xFFFF_FFFF, 0x0000_2A00], dtype=np.uint32),
+    )
+
+    MultiArrayDimension = T["std_msgs/msg/MultiArrayDimension"]
+    uint8_multi_array = T["std_msgs/msg/UInt8MultiArray"](
+        layout=T["std_msgs/msg/MultiArrayLayout"](
+            dim=[MultiArrayDimension(label="raw_data_stream", size=7, stride=1)],
+            data_offset=0,
+        ),
+        data=np.array([0xB5, 0x62, 0x02, 0x15, 0x10, 0x00, 0xFF], dtype=np.uint8),
+    )
+
     return [
         ("imu", "sensor_msgs/msg/Imu", imu),
         ("nav_sat_fix", "sensor_msgs/msg/NavSatFix", nav_sat_fix),
@@ -242,11 +370,14 @@ def build_messages(ts):
         ("twist_with_covariance_stamped", "geometry_msgs/msg/TwistWithCovarianceStamped", twist_stamped),
         ("gnss_measurements", f"{PACKAGE}/msg/GnssMeasurements", gnss_measurements),
         ("noise_estimates", f"{PACKAGE}/msg/NoiseEstimates", noise_estimates),
+        ("ubx_rxm_rawx", U + "UBXRxmRawx", ubx_rxm_rawx),
+        ("ubx_rxm_sfrbx", U + "UBXRxmSfrbx", ubx_rxm_sfrbx),
+        ("uint8_multi_array", "std_msgs/msg/UInt8MultiArray", uint8_multi_array),
     ]
 
 
 # Fixtures also written big-endian (CDR_BE), to prove the decoder reads that encapsulation.
-BIG_ENDIAN_TOO = {"imu", "gnss_measurements"}
+BIG_ENDIAN_TOO = {"imu", "gnss_measurements", "ubx_rxm_rawx"}
 
 
 def main():

@@ -39,6 +39,9 @@ pub struct EpochStats {
     pub satellites: usize,
     /// Satellites of a system or with signals this crate does not use.
     pub unsupported: usize,
+    /// Satellites left out because the input holds two measurements of one of their
+    /// signals (corrupt or forged input: which one is right cannot be known).
+    pub duplicate_signals: usize,
     /// Satellites left out for lack of a dual-frequency pair (ionosphere-free mode).
     pub single_frequency: usize,
     /// Satellites skipped for lack of a healthy, valid ephemeris.

@@ -14,6 +14,8 @@
 //!   does; [`names`]: topic-name resolution.
 //! - [`node`]: the `gnss_ins_node` ROS 2 node (ros2-client) around the engine.
 //! - [`player`]: `gnss_ins play`, a recorded bag published onto DDS.
+//! - [`ubx_adapter`]: the u-blox drivers' raw GNSS messages -> GnssMeasurements
+//!   (`gnss_ins convert --bag`, and the live adapter node).
 
 pub mod args;
 pub mod bag;
@@ -27,3 +29,4 @@ pub mod node;
 pub mod outbound;
 pub mod param_overrides;
 pub mod player;
+pub mod ubx_adapter;

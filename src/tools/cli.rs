@@ -87,8 +87,9 @@ pub enum Command {
         #[arg(long)]
         plots: Option<PathBuf>,
     },
-    /// Convert a u-blox UBX log and an IMU CSV (and a reference) into a bag.
-    Convert(ConvertArgs),
+    /// Convert a u-blox UBX log and an IMU CSV (and a reference), or a robot's bag with
+    /// the u-blox drivers' raw GNSS and its IMU, into a bag.
+    Convert(Box<ConvertArgs>),
     /// Single-point solutions of every epoch of a bag or UBX log, scored against its
     /// reference.
     Spp(SppArgs),
@@ -248,7 +249,7 @@ pub fn run(command: Command) -> Result<(), String> {
             Ok(())
         }
         Command::Play(args) => cli_play::play(args),
-        Command::Convert(args) => cli_real::convert(args),
+        Command::Convert(args) => cli_real::convert(*args),
         Command::Spp(args) => cli_real::spp(args),
         Command::SppRinex(args) => cli_real::spp_rinex(args),
         Command::Demo { seed } => {

@@ -10,6 +10,10 @@ use super::convert::{
     convert as convert_files, ConvertOptions, ConvertSummary, EphemerisMode, GnssSource, ImuInput,
     ImuTime, TruthInput,
 };
+use super::convert_bag::{
+    RobotBag, RobotBagSummary, RobotBagTopics, UbxInput, DEFAULT_IMU_TOPIC, DEFAULT_RAWX_TOPIC,
+    DEFAULT_SFRBX_TOPIC, DEFAULT_STREAM_TOPIC,
+};
 use super::imu_csv::{AccelUnit, GyroUnit, ImuCsvFormat};
 use super::replay::bag_inputs;
 use super::simulate::TRUTH_TOPIC;
@@ -19,6 +23,7 @@ use super::time_scale::DEFAULT_GPS_UTC_LEAP_S;
 use crate::gnss::atmosphere::TroposphereModel;
 use crate::gnss::ionosphere::IonosphereMode;
 use crate::gnss::rinex_spp::{Ionosphere, RinexSppOptions};
+use crate::ros::ubx_adapter::{TimeBase, DEFAULT_HOST_LATENCY_S};
 
 /// Unit of the accelerometer columns.
 #[derive(Clone, Copy, ValueEnum)]
@@ -72,6 +77,84 @@ pub enum ClockArg {
     PerConstellation,
 }
 
+/// The clock of the GNSS stamps of a converted robot bag.
+#[derive(Clone, Copy, ValueEnum)]
+pub enum TimeBaseArg {
+    /// The receiver's time: GPST - leap seconds (for IMU stamps on a synced host clock).
+    Gnss,
+    /// The driver's receive stamp (a stream chunk's log time) - --host-latency-s.
+    Host,
+}
+
+/// A robot's bag as the GNSS and IMU input of `convert`.
+#[derive(Args, Clone)]
+pub struct RobotBagArgs {
+    /// A robot's rosbag2 MCAP bag (.mcap file or bag directory) with the u-blox drivers'
+    /// raw GNSS (ublox_dgnss UBXRxmRawx + UBXRxmSfrbx, or ublox_gps's byte stream as
+    /// std_msgs/UInt8MultiArray) and sensor_msgs/Imu, converted through the live adapter:
+    /// as received, whatever --ephemeris says. The IMU messages are copied as recorded.
+    #[arg(long, conflicts_with_all = ["ubx", "rinex_obs", "imu_csv", "truth_ubx"])]
+    pub bag: Option<PathBuf>,
+    /// Topic of the UBXRxmRawx messages in --bag.
+    #[arg(long, default_value = DEFAULT_RAWX_TOPIC)]
+    pub rawx_topic: String,
+    /// Topic of the UBXRxmSfrbx messages in --bag.
+    #[arg(long, default_value = DEFAULT_SFRBX_TOPIC)]
+    pub sfrbx_topic: String,
+    /// Topic of the UBX byte stream (UInt8MultiArray) in --bag, read when the bag has no
+    /// RAWX messages.
+    #[arg(long, default_value = DEFAULT_STREAM_TOPIC)]
+    pub ubx_stream_topic: String,
+    /// Topic of the sensor_msgs/Imu messages in --bag.
+    #[arg(long, default_value = DEFAULT_IMU_TOPIC)]
+    pub imu_topic: String,
+    /// Clock of the GNSS stamps written for --bag.
+    #[arg(long, value_enum, default_value_t = TimeBaseArg::Gnss)]
+    pub time_base: TimeBaseArg,
+    /// Receiver output latency (s): measurement epoch to the host receive stamp; host
+    /// stamps are the receive stamp minus this, and the clock check expects it.
+    #[arg(long, default_value_t = DEFAULT_HOST_LATENCY_S)]
+    pub host_latency_s: f64,
+}
+
+impl Default for RobotBagArgs {
+    fn default() -> Self {
+        let topics = RobotBagTopics::default();
+        Self {
+            bag: None,
+            rawx_topic: topics.rawx,
+            sfrbx_topic: topics.sfrbx,
+            ubx_stream_topic: topics.stream,
+            imu_topic: topics.imu,
+            time_base: TimeBaseArg::Gnss,
+            host_latency_s: DEFAULT_HOST_LATENCY_S,
+        }
+    }
+}
+
+impl RobotBagArgs {
+    /// The GNSS source of `--bag`, if given.
+    fn source(&self) -> Option<GnssSource> {
+        let path = self.bag.clone()?;
+        Some(GnssSource::Bag {
+            bag: RobotBag {
+                path,
+                topics: RobotBagTopics {
+                    rawx: self.rawx_topic.clone(),
+                    sfrbx: self.sfrbx_topic.clone(),
+                    stream: self.ubx_stream_topic.clone(),
+                    imu: self.imu_topic.clone(),
+                },
+            },
+            time_base: match self.time_base {
+                TimeBaseArg::Gnss => TimeBase::Gnss,
+                TimeBaseArg::Host => TimeBase::Host,
+            },
+            host_latency_s: self.host_latency_s,
+        })
+    }
+}
+
 /// Which ephemerides give the satellite states.
 #[derive(Clone, Copy, ValueEnum)]
 pub enum EphemerisArg {
@@ -107,7 +190,7 @@ pub struct ConvertArgs {
     /// --truth-ubx). RAWX carries GPS time, so the log needs no time tag.
     #[arg(
         long,
-        required_unless_present = "rinex_obs",
+        required_unless_present_any = ["rinex_obs", "bag"],
         conflicts_with = "rinex_obs"
     )]
     pub ubx: Option<PathBuf>,
@@ -139,6 +222,8 @@ pub struct ConvertArgs {
     /// the tag's last record.
     #[arg(long)]
     pub imu_tag: Option<PathBuf>,
+    #[command(flatten)]
+    pub robot_bag: RobotBagArgs,
     #[command(flatten)]
     pub reference: ReferenceArgs,
     #[arg(long, value_enum, default_value_t = EphemerisArg::WholeLog)]
@@ -204,7 +289,10 @@ impl ConvertArgs {
                 obs: obs.clone(),
                 nav: nav.clone(),
             },
-            _ => return Err("give either --ubx or --rinex-obs with --rinex-nav".to_owned()),
+            (None, None, None) if self.robot_bag.bag.is_some() => {
+                self.robot_bag.source().ok_or("--bag needs a path")?
+            }
+            _ => return Err("give either --ubx, --rinex-obs with --rinex-nav, or --bag".to_owned()),
         };
         Ok(ConvertOptions {
             gnss,
@@ -266,6 +354,48 @@ fn print_convert_summary(out: &std::path::Path, s: &ConvertSummary) {
     for (reason, n) in &s.truth_skipped {
         eprintln!("skipped {n} reference lines: {reason}");
     }
+    if let Some(bag) = &s.robot_bag {
+        print_robot_bag_summary(bag);
+    }
+}
+
+fn print_robot_bag_summary(s: &RobotBagSummary) {
+    let input = match s.input {
+        UbxInput::DriverMessages => "UBXRxmRawx/UBXRxmSfrbx messages",
+        UbxInput::ByteStream => "the UBX byte stream",
+    };
+    eprintln!("raw GNSS read from {input}; what the adapter counted:");
+    let counts = s.counts.key_values();
+    let nonzero: Vec<String> = counts
+        .iter()
+        .filter(|(_, v)| v != "0")
+        .map(|(k, v)| format!("{k} {v}"))
+        .collect();
+    eprintln!("  {}", nonzero.join(", "));
+    let ms = |v: f64| format!("{:.1} ms", v * 1e3);
+    match s.clock.receiver_to_host_s {
+        Some((mean, jitter)) => eprintln!(
+            "  receiver time to host receive stamp: {} (jitter {})",
+            ms(mean),
+            ms(jitter)
+        ),
+        None => eprintln!("  receiver time to host receive stamp: unknown"),
+    }
+    match s.clock.imu_gnss_skew_s {
+        Some(skew) => eprintln!(
+            "  {}IMU/GNSS stamp skew beyond --host-latency-s: {}",
+            if s.clock.skew_exceeded {
+                "warning: "
+            } else {
+                ""
+            },
+            ms(skew)
+        ),
+        None => eprintln!("  IMU/GNSS stamp skew: unknown (no IMU message near a GNSS epoch)"),
+    }
+    if s.read_errors > 0 {
+        eprintln!("warning: {} bag read errors (messages lost)", s.read_errors);
+    }
 }
 
 /// `gnss_ins convert`.
@@ -303,6 +433,7 @@ pub fn spp(args: SppArgs) -> Result<(), String> {
             imu_gyro_unit: GyroUnitArg::DegPerS,
             imu_to_flu_rpy_deg: vec![0.0; 3],
             imu_tag: None,
+            robot_bag: RobotBagArgs::default(),
             reference: args.reference.clone(),
             ephemeris: EphemerisArg::WholeLog,
             ionosphere: args.ionosphere,

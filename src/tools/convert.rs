@@ -1,5 +1,6 @@
 //! `gnss_ins convert`: a u-blox UBX log, an IMU CSV and optionally a reference trajectory
-//! written as a rosbag2 MCAP bag of this package's messages.
+//! written as a rosbag2 MCAP bag of this package's messages; or a robot's bag with the
+//! u-blox drivers' raw GNSS and its IMU ([`super::convert_bag`]).
 //!
 //! Topics (the names `simulate` uses, so `replay` and `compare` read both alike):
 //! - `/gnss/measurements`: GnssMeasurements, one per UBX-RXM-RAWX epoch with satellites,
@@ -40,7 +41,9 @@ use crate::ros::msg::{
     Vector3 as RosVector3,
 };
 use crate::ros::outbound;
+use crate::ros::ubx_adapter::{TimeBase, UbxAdapterParams, MAX_LEAP_SECONDS};
 
+use super::convert_bag::{read_robot_bag, RobotBag, RobotBagError, RobotBagSummary};
 use super::imu_csv::{gpst_from_column, gpst_from_tag, parse_imu_csv, ImuCsvError, ImuCsvFormat};
 use super::rtklib_pos::{parse_pos, PosQuality};
 use super::simulate::{
@@ -107,6 +110,15 @@ pub enum GnssSource {
     /// navigation header's Klobuchar coefficients when it has them; the
     /// ionosphere-free mode is refused rather than silently changed.
     Rinex { obs: PathBuf, nav: PathBuf },
+    /// A robot's bag with the u-blox drivers' raw GNSS and its IMU, converted through the
+    /// live adapter ([`super::convert_bag`]): always as received, stamped on
+    /// `time_base` (`host_latency_s` before the host receive stamps for
+    /// [`TimeBase::Host`]).
+    Bag {
+        bag: RobotBag,
+        time_base: TimeBase,
+        host_latency_s: f64,
+    },
 }
 
 /// What to convert.
@@ -146,6 +158,13 @@ pub enum ConvertError {
     NoTruth { path: String },
     #[error("GPST {gpst_s} s is no ROS time")]
     Time { gpst_s: f64 },
+    #[error("{path}: {source}")]
+    RobotBag {
+        path: String,
+        source: Box<RobotBagError>,
+    },
+    #[error("--leap-seconds {0} must be a whole number of seconds for --bag")]
+    FractionalLeapSeconds(f64),
     #[error(transparent)]
     Bag(#[from] BagError),
 }
@@ -173,6 +192,8 @@ pub struct ConvertSummary {
     pub truth_skipped: Vec<(String, usize)>,
     /// First and last stamps written (UTC s).
     pub span_utc_s: (f64, f64),
+    /// For a robot bag: what the adapter read, used and dropped.
+    pub robot_bag: Option<RobotBagSummary>,
 }
 
 /// One reference sample, GPST.
@@ -228,6 +249,19 @@ pub fn convert(options: &ConvertOptions, out: &Path) -> Result<ConvertSummary, C
         GnssSource::Rinex { obs, nav } => {
             rinex_items(obs, nav, options, &mut items, &mut summary)?;
             (obs, None)
+        }
+        GnssSource::Bag {
+            bag,
+            time_base,
+            host_latency_s,
+        } => {
+            let params = UbxAdapterParams {
+                time_base: *time_base,
+                host_latency_s: *host_latency_s,
+                ..adapter_params(options)?
+            };
+            robot_bag_items(bag, params, &mut items, &mut summary)?;
+            (&bag.path, None)
         }
     };
     let gnss_path = gnss_path.display().to_string();
@@ -336,6 +370,57 @@ fn gnss_items(
         summary.satellites += built.epoch.satellites.len();
         items.push((ns, Item::Gnss(Box::new(msg))));
     }
+    Ok(())
+}
+
+/// The adapter parameters `options` set: leap seconds and ionosphere (the rest default).
+fn adapter_params(options: &ConvertOptions) -> Result<UbxAdapterParams, ConvertError> {
+    let leap = options.leap_seconds;
+    let whole = leap.fract() == 0.0 && leap.abs() <= f64::from(MAX_LEAP_SECONDS);
+    if !whole {
+        return Err(ConvertError::FractionalLeapSeconds(leap));
+    }
+    Ok(UbxAdapterParams {
+        leap_seconds: leap as i32,
+        ionosphere: options.ionosphere,
+        ..UbxAdapterParams::default()
+    })
+}
+
+/// The GNSS epochs and IMU samples of a robot bag.
+fn robot_bag_items(
+    bag: &RobotBag,
+    params: UbxAdapterParams,
+    items: &mut Vec<(u64, Item)>,
+    summary: &mut ConvertSummary,
+) -> Result<(), ConvertError> {
+    let (messages, read) =
+        read_robot_bag(bag, params).map_err(|source| ConvertError::RobotBag {
+            path: bag.path.display().to_string(),
+            source: Box::new(source),
+        })?;
+    for (ns, msg) in messages.gnss {
+        summary.gnss_epochs += 1;
+        summary.satellites += msg.satellites.len();
+        summary.klobuchar |= msg.klobuchar_alpha.iter().all(|a| a.is_finite());
+        items.push((ns, Item::Gnss(Box::new(msg))));
+    }
+    for (ns, msg) in messages.imu {
+        items.push((ns, Item::Imu(Box::new(msg))));
+    }
+    summary.empty_epochs = read.counts.empty_epochs as usize;
+    summary.single_frequency = read.counts.satellites.single_frequency;
+    summary.receiver_leap_seconds = read
+        .receiver_leap_seconds
+        .and_then(|s| i8::try_from(s).ok());
+    summary.imu_samples = read.imu_samples;
+    if read.imu_skipped > 0 {
+        summary.imu_skipped.push((
+            "undecodable or stamped before 1970".to_owned(),
+            read.imu_skipped,
+        ));
+    }
+    summary.robot_bag = Some(read);
     Ok(())
 }
 

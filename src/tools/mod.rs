@@ -7,6 +7,7 @@ pub mod cli_play;
 pub mod cli_real;
 pub mod compare;
 pub mod convert;
+pub mod convert_bag;
 pub mod imu_csv;
 pub mod plots;
 pub mod replay;

@@ -12,6 +12,8 @@
 //!   receiver clock (see [`crate::gnss::ephemeris::state_at_transmission`]).
 //! - Rate: ρ̇ = −λ · D (u-blox Doppler is positive for an approaching satellite), σ_ρ̇ =
 //!   λ · σ_D; the pseudo-range σ is the receiver's prStdev.
+//! - A satellite with two measurement blocks of one signal (gnssId, svId, sigId), which
+//!   a receiver never outputs, is left out whole (counted as `duplicate_signals`).
 
 use super::ids::{sat_id, signal};
 use super::rawx::{RawMeasurement, RawX};
@@ -48,8 +50,13 @@ pub fn build_epoch_with(
     sats.sort();
     sats.dedup();
     stats.satellites = sats.len();
+    let duplicated = satellites_with_duplicate_signals(raw);
     let mut candidates = Vec::new();
     for sat in sats {
+        if duplicated.binary_search(&sat).is_ok() {
+            stats.duplicate_signals += 1;
+            continue;
+        }
         let chosen = match mode {
             IonosphereMode::IonoFree => choose_pair(raw, sat),
             IonosphereMode::Broadcast | IonosphereMode::None => {
@@ -72,6 +79,24 @@ pub fn build_epoch_with(
         }
     }
     complete_epoch(receive_time, candidates, store, klobuchar, stats)
+}
+
+/// The satellites (sorted) of which `raw` holds two blocks of one signal.
+fn satellites_with_duplicate_signals(raw: &RawX) -> Vec<SatId> {
+    let mut keys: Vec<(u8, u8, u8)> = raw
+        .measurements
+        .iter()
+        .map(|m| (m.gnss_id, m.sv_id, m.sig_id))
+        .collect();
+    keys.sort_unstable();
+    let mut sats: Vec<SatId> = keys
+        .windows(2)
+        .filter(|w| w[0] == w[1])
+        .filter_map(|w| sat_id(w[0].0, w[0].1))
+        .collect();
+    sats.sort();
+    sats.dedup();
+    sats
 }
 
 /// The usable measurement of `sat` on `wanted`.

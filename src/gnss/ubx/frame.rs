@@ -1,12 +1,15 @@
 //! UBX framing: sync 0xB5 0x62, class, id, little-endian payload length, payload, and the
-//! 8-bit Fletcher checksum over class..payload. The reader resynchronizes on any garbage
-//! and never panics.
+//! 8-bit Fletcher checksum over class..payload. The reader resynchronizes on any garbage,
+//! in time linear in the input (see [`super::scanner`]), and never panics.
 //!
 //! Choice (resynchronization): after a bad checksum, or a header whose declared length
-//! runs past the end of the input, the search for the next sync pattern restarts one byte
-//! after the rejected sync, so a corrupt length field cannot swallow the frames behind it.
-//! A frame cut by the end of the input is counted as truncated; a frame cut in the middle
-//! of the stream (followed by other data) fails its checksum and is counted as corrupt.
+//! runs past the end of the input or beyond [`super::MAX_PAYLOAD_LEN`], the search for the
+//! next sync pattern restarts one byte after the rejected sync, so a corrupt length field
+//! cannot swallow the frames behind it. A frame cut by the end of the input is counted as
+//! truncated; a frame cut in the middle of the stream (followed by other data) fails its
+//! checksum and is counted as corrupt.
+
+use super::scanner::Scanner;
 
 /// First sync byte.
 pub const SYNC_1: u8 = 0xB5;
@@ -39,7 +42,9 @@ pub struct FrameStats {
     pub bad_checksum: usize,
     /// Frames whose declared length runs past the end of the input.
     pub truncated: usize,
-    /// Bytes skipped while looking for a sync pattern.
+    /// Headers declaring a payload longer than [`super::MAX_PAYLOAD_LEN`].
+    pub oversized: usize,
+    /// Bytes that are not part of a valid frame (garbage, rejected frames).
     pub skipped_bytes: usize,
 }
 
@@ -66,12 +71,11 @@ pub fn encode_frame(class: u8, id: u8, payload: &[u8]) -> Option<Vec<u8>> {
 }
 
 /// Iterator over the valid UBX frames of a byte buffer; [`FrameReader::stats`] tells what
-/// was skipped.
+/// was skipped. The buffer is the whole input: a frame cut by its end is truncated.
 #[derive(Debug, Clone)]
 pub struct FrameReader<'a> {
     data: &'a [u8],
-    pos: usize,
-    stats: FrameStats,
+    scanner: Scanner,
 }
 
 impl<'a> FrameReader<'a> {
@@ -79,40 +83,13 @@ impl<'a> FrameReader<'a> {
     pub fn new(data: &'a [u8]) -> Self {
         Self {
             data,
-            pos: 0,
-            stats: FrameStats::default(),
+            scanner: Scanner::default(),
         }
     }
 
     /// Counts so far.
     pub fn stats(&self) -> FrameStats {
-        self.stats
-    }
-
-    /// Tries a frame at `start` (where the sync bytes are): Some(frame) if complete and
-    /// valid; None otherwise (counted).
-    fn frame_at(&mut self, start: usize) -> Option<UbxFrame<'a>> {
-        let header = self.data.get(start..start.checked_add(HEADER_LEN)?)?;
-        let (class, id) = (*header.get(2)?, *header.get(3)?);
-        let len = usize::from(u16::from_le_bytes([*header.get(4)?, *header.get(5)?]));
-        let end = start + HEADER_LEN + len + CHECKSUM_LEN;
-        let Some(frame) = self.data.get(start..end) else {
-            self.stats.truncated += 1;
-            return None;
-        };
-        let body = frame.get(2..HEADER_LEN + len)?;
-        let (a, b) = checksum(body);
-        if frame.get(HEADER_LEN + len..) != Some(&[a, b][..]) {
-            self.stats.bad_checksum += 1;
-            return None;
-        }
-        self.stats.frames += 1;
-        Some(UbxFrame {
-            class,
-            id,
-            payload: frame.get(HEADER_LEN..HEADER_LEN + len)?,
-            offset: start,
-        })
+        self.scanner.stats()
     }
 }
 
@@ -120,35 +97,20 @@ impl<'a> Iterator for FrameReader<'a> {
     type Item = UbxFrame<'a>;
 
     fn next(&mut self) -> Option<UbxFrame<'a>> {
-        loop {
-            let rest = self.data.get(self.pos..)?;
-            let Some(found) = rest
-                .windows(2)
-                .position(|w| w.first() == Some(&SYNC_1) && w.get(1) == Some(&SYNC_2))
-            else {
-                // No sync left: the remaining bytes (bar a possible lone first sync byte
-                // at the very end, also garbage) are skipped.
-                self.stats.skipped_bytes += rest.len();
-                self.pos = self.data.len();
-                return None;
-            };
-            self.stats.skipped_bytes += found;
-            let start = self.pos + found;
-            if start + HEADER_LEN > self.data.len() {
-                // A sync pattern with an incomplete header at the end of the input.
-                self.stats.truncated += 1;
-                self.pos = self.data.len();
-                return None;
-            }
-            match self.frame_at(start) {
-                Some(frame) => {
-                    self.pos = start + HEADER_LEN + frame.payload.len() + CHECKSUM_LEN;
-                    return Some(frame);
-                }
-                None => self.pos = start + 1,
-            }
-        }
+        let (start, end) = self.scanner.next(self.data, 0, true)?;
+        frame_of(self.data.get(start..end)?, start)
     }
+}
+
+/// The frame whose bytes (sync to checksum, already verified) are `bytes`, found at
+/// absolute offset `offset`.
+pub(crate) fn frame_of(bytes: &[u8], offset: usize) -> Option<UbxFrame<'_>> {
+    Some(UbxFrame {
+        class: *bytes.get(2)?,
+        id: *bytes.get(3)?,
+        payload: bytes.get(HEADER_LEN..bytes.len().checked_sub(CHECKSUM_LEN)?)?,
+        offset,
+    })
 }
 
 #[cfg(test)]
@@ -184,8 +146,7 @@ mod tests {
         assert_eq!(stats.frames, 2);
         assert_eq!(stats.bad_checksum, 1);
         assert_eq!(stats.truncated, 1);
-        // 3 leading garbage bytes; the bad frame's bytes after its sync are re-scanned
-        // (1 byte from the re-scan start at sync+1 ... up to the next good sync).
-        assert!(stats.skipped_bytes >= 3);
+        // Every byte outside the two valid frames: garbage, the bad frame, the cut one.
+        assert_eq!(stats.skipped_bytes, data.len() - 2 * good.len());
     }
 }

@@ -81,9 +81,15 @@ pub fn iod_nav(word: &InavWord) -> Option<u16> {
         .and_then(|v| u16::try_from(v).ok())
 }
 
-/// Ephemeris from word types 1–4 (same IODnav) and 5 (BGD, health); `reference` (GPST
-/// within days) resolves the week of toe and toc. None if a word has the wrong type, the
-/// IODnavs differ, or a field is missing.
+/// Ephemeris from word types 1–4 (same IODnav) and 5 (BGD, health); None while the
+/// IODnavs differ. `reference` (GPST within days) resolves the week of toe and toc.
+///
+/// Choice: differing IODnavs are never an error: I/NAV words carry no count that would
+/// tell one batch's broadcast from the next, so a new batch arriving and a corrupt word
+/// look alike; either way no ephemeris is formed until the four agree.
+///
+/// Errors: [`NavDataError::PageLayout`] when a word has the wrong type,
+/// [`NavDataError::MissingField`] when a field lies beyond the bits.
 ///
 /// Choice (health): the stored health packs E5b HS, E1-B HS, E5b DVS and E1-B DVS
 /// (bits 5..0: hs5b<<4 | hs1b<<2 | dvs5b<<1 | dvs1b); the store uses only sets whose four
@@ -92,16 +98,29 @@ pub fn decode_inav_ephemeris(
     sat: SatId,
     words: [&InavWord; 5],
     reference: &GpsTime,
+) -> Result<Option<KeplerianEphemeris>, NavDataError> {
+    let types = words.map(|w| w.word_type);
+    if types != [1, 2, 3, 4, 5] {
+        return Err(NavDataError::PageLayout { sat });
+    }
+    let missing = NavDataError::MissingField { sat };
+    let iod = iod_nav(words[0]).ok_or(missing.clone())?;
+    if words[1..4].iter().any(|w| iod_nav(w) != Some(iod)) {
+        return Ok(None);
+    }
+    inav_elements(sat, words, iod, reference)
+        .map(Some)
+        .ok_or(missing)
+}
+
+/// The elements of word types 1–5 of issue `iod`.
+fn inav_elements(
+    sat: SatId,
+    words: [&InavWord; 5],
+    iod: u16,
+    reference: &GpsTime,
 ) -> Option<KeplerianEphemeris> {
     let [w1, w2, w3, w4, w5] = words;
-    let types = [w1, w2, w3, w4, w5].map(|w| w.word_type);
-    if types != [1, 2, 3, 4, 5] {
-        return None;
-    }
-    let iod = iod_nav(w1)?;
-    if [w2, w3, w4].iter().any(|w| iod_nav(w) != Some(iod)) {
-        return None;
-    }
     let sc = std::f64::consts::PI;
     let (d1, d2, d3, d4, d5) = (&w1.data, &w2.data, &w3.data, &w4.data, &w5.data);
     let f = |v: Option<i64>, scale: f64| v.map(|x| x as f64 * scale);

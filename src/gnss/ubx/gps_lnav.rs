@@ -84,9 +84,16 @@ pub fn nearest_gps_time(tow_s: f64, reference: &GpsTime) -> GpsTime {
         .unwrap_or(GpsTime::new(reference.week, tow_s))
 }
 
-/// Ephemeris from subframes 1, 2 and 3 (data bits), or None if their issues of data
-/// disagree (IODC LSBs, IODE of 2 and 3) or a field is missing. `reference` (a GPST
-/// within a few days, e.g. the receive time) resolves the weeks of toe and toc.
+/// Ephemeris from subframes 1, 2 and 3 (data bits) of one issue of data (the 8 LSBs of
+/// subframe 1's IODC and the IODE of subframes 2 and 3 agree), which may come from
+/// different frames; None while they are of different issues (a new upload arriving).
+/// `reference` (a GPST within a few days, e.g. the receive time) resolves the weeks of
+/// toe and toc.
+///
+/// Errors: [`NavDataError::IssueMismatch`] when the issues disagree within one frame
+/// (consecutive HOW TOW counts), where a new upload never begins (IS-GPS-200 20.3.4.1:
+/// cutovers are at frame boundaries): the clock does not match the orbit;
+/// [`NavDataError::MissingField`] when a field lies beyond the bits.
 pub fn decode_lnav_ephemeris(
     sat: SatId,
     source: NavSource,
@@ -94,14 +101,40 @@ pub fn decode_lnav_ephemeris(
     sf2: &Bits,
     sf3: &Bits,
     reference: &GpsTime,
+) -> Result<Option<KeplerianEphemeris>, NavDataError> {
+    let missing = NavDataError::MissingField { sat };
+    let field = |bits: &Bits, pos, len| bits.u(pos, len).ok_or(missing.clone());
+    let iodc = sf1.u2(70, 2, 168, 8).ok_or(missing.clone())?;
+    let iode2 = field(sf2, 48, 8)?;
+    let iode3 = field(sf3, 216, 8)?;
+    if iode2 == iode3 && iodc & 0xFF == iode2 {
+        return lnav_elements(sat, source, sf1, sf2, sf3, iode2, reference)
+            .map(Some)
+            .ok_or(missing);
+    }
+    let tow = [
+        field(sf1, 24, 17)?,
+        field(sf2, 24, 17)?,
+        field(sf3, 24, 17)?,
+    ];
+    if tow[1] == tow[0] + 1 && tow[2] == tow[0] + 2 {
+        Err(NavDataError::IssueMismatch { sat })
+    } else {
+        Ok(None)
+    }
+}
+
+/// The elements of subframes 1–3 of issue `iode`.
+fn lnav_elements(
+    sat: SatId,
+    source: NavSource,
+    sf1: &Bits,
+    sf2: &Bits,
+    sf3: &Bits,
+    iode: u64,
+    reference: &GpsTime,
 ) -> Option<KeplerianEphemeris> {
     let sc = std::f64::consts::PI;
-    let iodc = sf1.u2(70, 2, 168, 8)?;
-    let iode2 = sf2.u(48, 8)?;
-    let iode3 = sf3.u(216, 8)?;
-    if iode2 != iode3 || iodc & 0xFF != iode2 {
-        return None;
-    }
     let fit_flag = sf2.u(232, 1)?;
     let f = |v: Option<i64>, scale: f64| v.map(|x| x as f64 * scale);
     let g = |v: Option<u64>, scale: f64| v.map(|x| x as f64 * scale);
@@ -131,7 +164,7 @@ pub fn decode_lnav_ephemeris(
         group_delay: GroupDelay::Gps {
             tgd_s: f(sf1.s(160, 8), pow2(-31))?,
         },
-        issue_of_data: u16::try_from(iode2).ok()?,
+        issue_of_data: u16::try_from(iode).ok()?,
         health: u16::try_from(sf1.u(64, 6)?).ok()?,
         validity_s: if fit_flag == 0 {
             VALIDITY_NORMAL_S
@@ -154,7 +187,7 @@ pub fn decode_lnav_klobuchar(sf4: &Bits) -> Option<Klobuchar> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::gnss::Constellation;
 
@@ -174,23 +207,26 @@ mod tests {
         w
     }
 
+    /// The u-blox words of a subframe of ten 24-bit data words, parity chained.
+    pub(crate) fn lnav_words(data: [u32; LNAV_WORDS]) -> Vec<u32> {
+        let (mut d29, mut d30) = (0, 0);
+        data.iter()
+            .map(|&d| {
+                let w = encode(d, d29, d30);
+                d29 = (w >> 1) & 1;
+                d30 = w & 1;
+                w
+            })
+            .collect()
+    }
+
     #[test]
     fn parity_accepts_encoded_words_and_rejects_a_flipped_bit() {
-        let mut words = Vec::new();
-        let (mut d29, mut d30) = (0, 0);
-        for k in 0..10u32 {
-            let d = if k == 0 {
-                0x8B0000
-            } else if k == 1 {
-                2 << 2
-            } else {
-                0x5A5A5A ^ k
-            };
-            let w = encode(d, d29, d30);
-            d29 = (w >> 1) & 1;
-            d30 = w & 1;
-            words.push(w);
-        }
+        let mut words = lnav_words(std::array::from_fn(|k| match k {
+            0 => 0x8B0000,
+            1 => 2 << 2,
+            _ => 0x5A5A5A ^ k as u32,
+        }));
         let sf = lnav_subframe(G01, &words).unwrap();
         assert_eq!(sf.id, 2);
         assert_eq!(sf.data.u(24 * 4, 24), Some(u64::from(0x5A5A5A ^ 4u32)));
@@ -203,5 +239,40 @@ mod tests {
             lnav_subframe(G01, &words[..9]),
             Err(NavDataError::WordCount { .. })
         ));
+    }
+
+    /// Subframe data bits with the HOW TOW count and the given (position, length,
+    /// value) fields set, the rest zero.
+    fn subframe(tow_count: u64, fields: &[(usize, usize, u64)]) -> Bits {
+        let mut bits = [0u8; 240];
+        for &(pos, len, value) in [(24, 17, tow_count)].iter().chain(fields) {
+            for k in 0..len {
+                bits[pos + k] = ((value >> (len - 1 - k)) & 1) as u8;
+            }
+        }
+        let mut data = Bits::new();
+        for b in bits {
+            data.push(u64::from(b), 1);
+        }
+        data
+    }
+
+    #[test]
+    fn clock_and_orbit_of_different_issues_within_one_frame_are_an_error() {
+        let t = GpsTime::new(2381, 408_000.0);
+        let decode = |tows: [u64; 3], iodc: u64, iode: u64| {
+            let sf1 = subframe(tows[0], &[(70, 2, iodc >> 8), (168, 8, iodc & 0xFF)]);
+            let sf2 = subframe(tows[1], &[(48, 8, iode)]);
+            let sf3 = subframe(tows[2], &[(216, 8, iode)]);
+            decode_lnav_ephemeris(G01, NavSource::GpsLnav, &sf1, &sf2, &sf3, &t)
+        };
+        let eph = decode([100, 101, 102], 0x1A7, 0xA7).unwrap().unwrap();
+        assert_eq!(eph.issue_of_data, 0xA7);
+        assert_eq!(
+            decode([100, 101, 102], 0x1A6, 0xA7),
+            Err(NavDataError::IssueMismatch { sat: G01 })
+        );
+        // Subframe 1 of the next frame, with the next upload: waiting for 2 and 3.
+        assert_eq!(decode([105, 101, 102], 0x1A6, 0xA7), Ok(None));
     }
 }

@@ -1,6 +1,7 @@
-//! u-blox UBX input, pure (bytes in, values out): framing with checksum verification,
+//! u-blox UBX input, pure (bytes in, values out): framing with checksum verification
+//! (of a whole log, or of a stream arriving in chunks),
 //! decoders for UBX-RXM-RAWX, UBX-RXM-SFRBX and UBX-NAV-PVT, navigation-message decoding
-//! (GPS/QZSS LNAV, Galileo I/NAV, BeiDou D1) into ephemerides, and the construction of a
+//! (GPS/QZSS LNAV, Galileo I/NAV, BeiDou D1/D2) into ephemerides, and the construction of a
 //! [`crate::gnss::GnssEpoch`] from RAWX and the ephemerides.
 //!
 //! Choice: written against the UBX interface description and the ICDs rather than on the
@@ -8,7 +9,10 @@
 //! of GPS only, so the Galileo and BeiDou work would remain anyway.
 
 mod beidou_d1;
+mod beidou_d2;
+mod beidou_subframe;
 mod bits;
+mod broadcast_nav;
 mod epoch;
 mod error;
 mod frame;
@@ -21,11 +25,16 @@ mod nav_error;
 mod nav_pvt;
 mod rawx;
 mod reader;
+mod scanner;
 mod sfrbx;
+mod stream;
 
 pub use crate::gnss::epoch_build::{preferred_signals, BuiltEpoch, EpochStats};
-pub use beidou_d1::{d1_subframe, decode_d1_ephemeris, D1Subframe};
+pub use beidou_d1::decode_d1_ephemeris;
+pub use beidou_d2::{d2_page, decode_d2_ephemeris, D2_EPHEMERIS_PAGES};
+pub use beidou_subframe::{bds_subframe, BdsSubframe};
 pub use bits::Bits;
+pub use broadcast_nav::{BroadcastNav, BroadcastNavStats};
 pub use epoch::{build_epoch, build_epoch_with};
 pub use error::UbxError;
 pub use frame::{checksum, encode_frame, FrameReader, FrameStats, UbxFrame};
@@ -38,6 +47,8 @@ pub use message::{decode_message, UbxMessage};
 pub use nav_decoder::{NavDecoder, NavDecoderStats, NavUpdate};
 pub use nav_error::NavDataError;
 pub use nav_pvt::{decode_nav_pvt, CarrierSolution, NavPvt};
-pub use rawx::{decode_rawx, RawMeasurement, RawX, TrackingStatus};
+pub use rawx::{decode_rawx, RawMeasurement, RawX, RawxBlock, TrackingStatus};
 pub use reader::{read_ubx_log, read_ubx_log_with, UbxLog, UbxLogStats};
+pub use scanner::{MAX_FRAME_LEN, MAX_PAYLOAD_LEN};
 pub use sfrbx::{decode_sfrbx, Sfrbx};
+pub use stream::UbxFramer;

@@ -1,9 +1,11 @@
 //! Assembly of SFRBX subframes/pages per satellite into ephemerides (GPS/QZSS LNAV,
-//! Galileo I/NAV, BeiDou D1) and the GPS Klobuchar parameters.
+//! Galileo I/NAV, BeiDou D1 and D2) and the GPS Klobuchar parameters, as they arrive.
 
 use std::collections::BTreeMap;
 
-use super::beidou_d1::{d1_subframe, decode_d1_ephemeris, D1Subframe};
+use super::beidou_d1::decode_d1_ephemeris;
+use super::beidou_d2::{d2_page, decode_d2_ephemeris, D2_EPHEMERIS_PAGES};
+use super::beidou_subframe::{bds_subframe, BdsSubframe};
 use super::bits::Bits;
 use super::galileo_inav::{decode_inav_ephemeris, inav_word, InavWord};
 use super::gps_lnav::{decode_lnav_ephemeris, decode_lnav_klobuchar, lnav_subframe};
@@ -27,9 +29,16 @@ pub enum NavUpdate {
 pub struct NavDecoderStats {
     /// Subframes/pages that passed their checks.
     pub accepted: usize,
-    /// Subframes/pages refused (parity, BCH, CRC, layout, word count).
+    /// Subframes/pages refused, for any reason (the two below, preamble, page layout).
     pub rejected: usize,
-    /// Messages of systems or signals not decoded (GLONASS, SBAS, CNAV, F/NAV, D2, …).
+    /// ... of which for a word count that does not fit the message type.
+    pub rejected_word_count: usize,
+    /// ... of which for a parity (GPS), BCH (BeiDou) or CRC (Galileo) error.
+    pub rejected_parity: usize,
+    /// Subframe sets of one frame whose issues of data contradict each other (see
+    /// [`NavDataError::IssueMismatch`]): no ephemeris formed from them.
+    pub issue_mismatch: usize,
+    /// Messages of systems or signals not decoded (GLONASS, SBAS, CNAV, F/NAV, …).
     pub unsupported: usize,
     /// Ephemerides emitted (new or changed).
     pub ephemerides: usize,
@@ -48,7 +57,13 @@ struct InavSlots {
 
 #[derive(Debug, Clone, Default)]
 struct D1Slots {
-    sf: [Option<D1Subframe>; 3],
+    sf: [Option<BdsSubframe>; 3],
+}
+
+/// The pages of [`D2_EPHEMERIS_PAGES`], in that order.
+#[derive(Debug, Clone, Default)]
+struct D2Slots {
+    pages: [Option<BdsSubframe>; 9],
 }
 
 /// Turns SFRBX messages into ephemerides; keeps partial subframe sets per satellite.
@@ -57,6 +72,7 @@ pub struct NavDecoder {
     lnav: BTreeMap<SatId, LnavSlots>,
     inav: BTreeMap<SatId, InavSlots>,
     d1: BTreeMap<SatId, D1Slots>,
+    d2: BTreeMap<SatId, D2Slots>,
     last: BTreeMap<(SatId, NavSourceKey), KeplerianEphemeris>,
     stats: NavDecoderStats,
 }
@@ -87,13 +103,14 @@ impl NavDecoder {
             self.stats.unsupported += 1;
             return None;
         };
+        let words = &msg.words;
         let result = match (msg.gnss_id, msg.sig_id) {
-            (GNSS_GPS, 0) => self.push_lnav(sat, NavSource::GpsLnav, &msg.words, reference),
-            (GNSS_QZSS, 0) => self.push_lnav(sat, NavSource::QzssLnav, &msg.words, reference),
-            (GNSS_GALILEO, 1) => self.push_inav(sat, &msg.words, reference),
-            (GNSS_BEIDOU, 0 | 2 | 4) if !is_beidou_geo(sat) => {
-                self.push_d1(sat, &msg.words, reference)
-            }
+            (GNSS_GPS, 0) => self.push_lnav(sat, NavSource::GpsLnav, words, reference),
+            (GNSS_QZSS, 0) => self.push_lnav(sat, NavSource::QzssLnav, words, reference),
+            (GNSS_GALILEO, 1) => self.push_inav(sat, words, reference),
+            // B1I/B2I/B3I D1 of MEO/IGSO, B1I/B2I D2 of GEO.
+            (GNSS_BEIDOU, 0 | 2 | 4) if !is_beidou_geo(sat) => self.push_d1(sat, words, reference),
+            (GNSS_BEIDOU, 1 | 3) if is_beidou_geo(sat) => self.push_d2(sat, words, reference),
             _ => {
                 self.stats.unsupported += 1;
                 return None;
@@ -107,8 +124,15 @@ impl NavDecoder {
                     other => other,
                 }
             }
-            Err(_) => {
+            Err(e) => {
                 self.stats.rejected += 1;
+                match e {
+                    NavDataError::WordCount { .. } => self.stats.rejected_word_count += 1,
+                    NavDataError::Parity { .. }
+                    | NavDataError::Bch { .. }
+                    | NavDataError::Crc { .. } => self.stats.rejected_parity += 1,
+                    _ => {}
+                }
                 None
             }
         }
@@ -123,6 +147,22 @@ impl NavDecoder {
         self.last.insert(key, eph);
         self.stats.ephemerides += 1;
         Some(NavUpdate::Ephemeris(eph))
+    }
+
+    /// The update of a complete set of slots: an ephemeris; nothing while its parts are
+    /// of different uploads or frames; nothing, counted, when they contradict each other.
+    fn completed(
+        &mut self,
+        decoded: Result<Option<KeplerianEphemeris>, NavDataError>,
+    ) -> Result<Option<NavUpdate>, NavDataError> {
+        match decoded {
+            Ok(eph) => Ok(eph.map(NavUpdate::Ephemeris)),
+            Err(NavDataError::IssueMismatch { .. }) => {
+                self.stats.issue_mismatch += 1;
+                Ok(None)
+            }
+            Err(e) => Err(e),
+        }
     }
 
     fn push_lnav(
@@ -142,8 +182,8 @@ impl NavDecoder {
                 let [Some(s1), Some(s2), Some(s3)] = &slots.sf else {
                     return Ok(None);
                 };
-                Ok(decode_lnav_ephemeris(sat, source, s1, s2, s3, reference)
-                    .map(NavUpdate::Ephemeris))
+                let decoded = decode_lnav_ephemeris(sat, source, s1, s2, s3, reference);
+                self.completed(decoded)
             }
             4 if source == NavSource::GpsLnav => {
                 Ok(decode_lnav_klobuchar(&sf.data).map(NavUpdate::Klobuchar))
@@ -170,7 +210,8 @@ impl NavDecoder {
         let [Some(w1), Some(w2), Some(w3), Some(w4), Some(w5)] = &slots.words else {
             return Ok(None);
         };
-        Ok(decode_inav_ephemeris(sat, [w1, w2, w3, w4, w5], reference).map(NavUpdate::Ephemeris))
+        let decoded = decode_inav_ephemeris(sat, [w1, w2, w3, w4, w5], reference);
+        self.completed(decoded)
     }
 
     fn push_d1(
@@ -179,7 +220,7 @@ impl NavDecoder {
         words: &[u32],
         reference: &GpsTime,
     ) -> Result<Option<NavUpdate>, NavDataError> {
-        let sf = d1_subframe(sat, words)?;
+        let sf = bds_subframe(sat, words)?;
         let slots = self.d1.entry(sat).or_default();
         if !(1..=3).contains(&sf.id) {
             return Ok(None);
@@ -190,10 +231,39 @@ impl NavDecoder {
         let [Some(s1), Some(s2), Some(s3)] = &slots.sf else {
             return Ok(None);
         };
-        Ok(decode_d1_ephemeris(sat, s1, s2, s3, reference).map(NavUpdate::Ephemeris))
+        let decoded = decode_d1_ephemeris(sat, s1, s2, s3, reference);
+        self.completed(decoded)
+    }
+
+    fn push_d2(
+        &mut self,
+        sat: SatId,
+        words: &[u32],
+        reference: &GpsTime,
+    ) -> Result<Option<NavUpdate>, NavDataError> {
+        let sf = bds_subframe(sat, words)?;
+        // Page 2 (ionosphere) and subframes 2–5 do not enter the ephemeris.
+        let Some(index) =
+            d2_page(&sf).and_then(|p| D2_EPHEMERIS_PAGES.iter().position(|e| *e == p))
+        else {
+            return Ok(None);
+        };
+        let slots = self.d2.entry(sat).or_default();
+        if let Some(slot) = slots.pages.get_mut(index) {
+            *slot = Some(sf);
+        }
+        let [Some(p1), Some(p3), Some(p4), Some(p5), Some(p6), Some(p7), Some(p8), Some(p9), Some(p10)] =
+            &slots.pages
+        else {
+            return Ok(None);
+        };
+        let pages = [p1, p3, p4, p5, p6, p7, p8, p9, p10];
+        let decoded = decode_d2_ephemeris(sat, pages, reference);
+        self.completed(decoded)
     }
 }
 
+/// BeiDou GEO satellites (PRN 1–5 and 59–63), which broadcast D2.
 fn is_beidou_geo(sat: SatId) -> bool {
     matches!(sat.prn, 1..=5 | 59..=63)
 }

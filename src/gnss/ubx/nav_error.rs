@@ -29,4 +29,12 @@ pub enum NavDataError {
     /// Galileo even/odd page parts out of order, or an alert page.
     #[error("{sat}: I/NAV page parts invalid (even/odd or page type)")]
     PageLayout { sat: SatId },
+    /// Subframes of one frame whose clock and orbit parts contradict each other (GPS:
+    /// IODC LSBs ≠ IODE; BeiDou: toc ≠ toe): corrupt or forged data, since a new upload
+    /// only ever starts at a frame boundary.
+    #[error("{sat}: clock and orbit subframes of one frame have different issues of data")]
+    IssueMismatch { sat: SatId },
+    /// A field beyond the data bits (never for subframes that passed their checks).
+    #[error("{sat}: field beyond the navigation data bits")]
+    MissingField { sat: SatId },
 }

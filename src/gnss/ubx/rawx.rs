@@ -73,6 +73,81 @@ pub struct RawX {
     pub measurements: Vec<RawMeasurement>,
 }
 
+/// One measurement block as transmitted: the RAWX payload's fields, unscaled (what a
+/// driver's message such as `ublox_ubx_msgs/RawxData` copies).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RawxBlock {
+    /// prMes (m).
+    pub pr_mes: f64,
+    /// cpMes (cycles).
+    pub cp_mes: f64,
+    /// doMes (Hz).
+    pub do_mes: f32,
+    pub gnss_id: u8,
+    pub sv_id: u8,
+    pub sig_id: u8,
+    pub freq_id: u8,
+    /// locktime (ms).
+    pub locktime_ms: u16,
+    /// cno (dB-Hz).
+    pub cno: u8,
+    /// prStdev, cpStdev, doStdev bytes (bits 0–3 hold the code).
+    pub pr_stdev: u8,
+    pub cp_stdev: u8,
+    pub do_stdev: u8,
+    /// trkStat byte.
+    pub trk_stat: u8,
+}
+
+impl RawMeasurement {
+    /// The measurement of a block, in SI units.
+    pub fn from_block(b: &RawxBlock) -> Self {
+        let code = |byte: u8| byte & 0x0F;
+        Self {
+            pseudorange_m: b.pr_mes,
+            carrier_phase_cycles: b.cp_mes,
+            doppler_hz: f64::from(b.do_mes),
+            gnss_id: b.gnss_id,
+            sv_id: b.sv_id,
+            sig_id: b.sig_id,
+            freq_id: b.freq_id,
+            lock_time_s: f64::from(b.locktime_ms) * 1e-3,
+            cn0_dbhz: f64::from(b.cno),
+            pseudorange_sigma_m: 0.01 * 2f64.powi(i32::from(code(b.pr_stdev))),
+            carrier_phase_sigma_cycles: 0.004 * f64::from(code(b.cp_stdev)),
+            doppler_sigma_hz: 0.002 * 2f64.powi(i32::from(code(b.do_stdev))),
+            tracking: TrackingStatus {
+                pr_valid: b.trk_stat & 0x01 != 0,
+                cp_valid: b.trk_stat & 0x02 != 0,
+                half_cycle_valid: b.trk_stat & 0x04 != 0,
+                half_cycle_subtracted: b.trk_stat & 0x08 != 0,
+            },
+        }
+    }
+}
+
+impl RawX {
+    /// A message from its header fields (recStat the status byte) and measurements.
+    pub fn new(
+        rcv_tow_s: f64,
+        week: u16,
+        leap_s: i8,
+        rec_stat: u8,
+        version: u8,
+        measurements: Vec<RawMeasurement>,
+    ) -> Self {
+        Self {
+            rcv_tow_s,
+            week,
+            leap_s,
+            leap_s_valid: rec_stat & 0x01 != 0,
+            clock_reset: rec_stat & 0x02 != 0,
+            version,
+            measurements,
+        }
+    }
+}
+
 /// Decodes a RAWX payload. The length must be exactly 16 + 32 · numMeas.
 pub fn decode_rawx(p: &[u8]) -> Result<RawX, UbxError> {
     let bad_length = |expected| UbxError::BadLength {
@@ -96,42 +171,36 @@ pub fn decode_rawx(p: &[u8]) -> Result<RawX, UbxError> {
     })();
     let (rcv_tow_s, week, leap_s, rec_stat, version) = head.ok_or(bad_length(expected))?;
     let measurements = (0..num)
-        .map(|k| measurement(p, HEADER_LEN + BLOCK_LEN * k).ok_or(bad_length(expected)))
+        .map(|k| {
+            block(p, HEADER_LEN + BLOCK_LEN * k)
+                .map(|b| RawMeasurement::from_block(&b))
+                .ok_or(bad_length(expected))
+        })
         .collect::<Result<Vec<_>, _>>()?;
-    Ok(RawX {
+    Ok(RawX::new(
         rcv_tow_s,
         week,
         leap_s,
-        leap_s_valid: rec_stat & 0x01 != 0,
-        clock_reset: rec_stat & 0x02 != 0,
+        rec_stat,
         version,
         measurements,
-    })
+    ))
 }
 
-fn measurement(p: &[u8], off: usize) -> Option<RawMeasurement> {
-    let pr_stdev = le::u8_at(p, off + 27)? & 0x0F;
-    let cp_stdev = le::u8_at(p, off + 28)? & 0x0F;
-    let do_stdev = le::u8_at(p, off + 29)? & 0x0F;
-    let trk = le::u8_at(p, off + 30)?;
-    Some(RawMeasurement {
-        pseudorange_m: le::f64_at(p, off)?,
-        carrier_phase_cycles: le::f64_at(p, off + 8)?,
-        doppler_hz: f64::from(le::f32_at(p, off + 16)?),
+fn block(p: &[u8], off: usize) -> Option<RawxBlock> {
+    Some(RawxBlock {
+        pr_mes: le::f64_at(p, off)?,
+        cp_mes: le::f64_at(p, off + 8)?,
+        do_mes: le::f32_at(p, off + 16)?,
         gnss_id: le::u8_at(p, off + 20)?,
         sv_id: le::u8_at(p, off + 21)?,
         sig_id: le::u8_at(p, off + 22)?,
         freq_id: le::u8_at(p, off + 23)?,
-        lock_time_s: f64::from(le::u16_at(p, off + 24)?) * 1e-3,
-        cn0_dbhz: f64::from(le::u8_at(p, off + 26)?),
-        pseudorange_sigma_m: 0.01 * 2f64.powi(i32::from(pr_stdev)),
-        carrier_phase_sigma_cycles: 0.004 * f64::from(cp_stdev),
-        doppler_sigma_hz: 0.002 * 2f64.powi(i32::from(do_stdev)),
-        tracking: TrackingStatus {
-            pr_valid: trk & 0x01 != 0,
-            cp_valid: trk & 0x02 != 0,
-            half_cycle_valid: trk & 0x04 != 0,
-            half_cycle_subtracted: trk & 0x08 != 0,
-        },
+        locktime_ms: le::u16_at(p, off + 24)?,
+        cno: le::u8_at(p, off + 26)?,
+        pr_stdev: le::u8_at(p, off + 27)?,
+        cp_stdev: le::u8_at(p, off + 28)?,
+        do_stdev: le::u8_at(p, off + 29)?,
+        trk_stat: le::u8_at(p, off + 30)?,
     })
 }

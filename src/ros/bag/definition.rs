@@ -103,7 +103,8 @@ mod tests {
     use super::*;
     use crate::ros::msg::{
         Clock, DiagnosticArray, GnssMeasurements, Imu, NavSatFix, NoiseEstimates, Odometry,
-        RosMessage, TFMessage, TwistWithCovarianceStamped,
+        RosMessage, TFMessage, TwistWithCovarianceStamped, UInt8MultiArray, UbxRxmRawx,
+        UbxRxmSfrbx,
     };
 
     /// The `MSG:` names of a full definition, in order.
@@ -160,6 +161,9 @@ mod tests {
             Clock::TYPE_NAME,
             GnssMeasurements::TYPE_NAME,
             NoiseEstimates::TYPE_NAME,
+            UbxRxmRawx::TYPE_NAME,
+            UbxRxmSfrbx::TYPE_NAME,
+            UInt8MultiArray::TYPE_NAME,
         ] {
             assert!(full_definition(type_name).is_ok(), "{type_name}");
         }

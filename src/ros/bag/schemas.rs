@@ -1,6 +1,7 @@
 //! Message definition texts (`.msg` format) of every type a bag may hold, keyed by
-//! `pkg/Type`. The standard ROS 2 Jazzy texts are written here field for field (comments
-//! left out); the package's own texts are the files of `msg/`.
+//! `pkg/Type`. The standard ROS 2 Jazzy texts, and those of the u-blox driver's
+//! `ublox_ubx_msgs`, are written here field for field (comments left out); the package's
+//! own texts are the files of `msg/`.
 
 use crate::ros::msg::{
     GNSS_MEASUREMENTS_MSG, NOISE_ESTIMATES_MSG, SATELLITE_MEASUREMENT_MSG, SATELLITE_NOISE_MSG,
@@ -125,6 +126,63 @@ pub const LOG_MSG: &str =
 builtin_interfaces/Time stamp\nuint8 level\nstring name\nstring msg\nstring file\n\
 string function\nuint32 line\n";
 
+/// `std_msgs/MultiArrayDimension`.
+pub const MULTI_ARRAY_DIMENSION_MSG: &str = "string label\nuint32 size\nuint32 stride\n";
+
+/// `std_msgs/MultiArrayLayout`.
+pub const MULTI_ARRAY_LAYOUT_MSG: &str = "MultiArrayDimension[] dim\nuint32 data_offset\n";
+
+/// `std_msgs/UInt8MultiArray`.
+pub const UINT8_MULTI_ARRAY_MSG: &str = "MultiArrayLayout layout\nuint8[] data\n";
+
+/// `ublox_ubx_msgs/RecStat`.
+pub const REC_STAT_MSG: &str = "bool leap_sec\nbool clk_reset\n";
+
+/// `ublox_ubx_msgs/TrkStat`.
+pub const TRK_STAT_MSG: &str = "bool pr_valid\nbool cp_valid\nbool half_cyc\nbool sub_half_cyc\n";
+
+/// `ublox_ubx_msgs/RawxData`.
+pub const RAWX_DATA_MSG: &str = "\
+float64 pr_mes
+float64 cp_mes
+float32 do_mes
+uint8 gnss_id
+uint8 sv_id
+uint8 sig_id
+uint8 freq_id
+uint16 locktime
+uint8 c_no
+uint8 pr_stdev
+uint8 cp_stdev
+uint8 do_stdev
+TrkStat trk_stat
+";
+
+/// `ublox_ubx_msgs/UBXRxmRawx`.
+pub const UBX_RXM_RAWX_MSG: &str = "\
+std_msgs/Header header
+float64 rcv_tow
+uint16 week
+int8 leap_s
+uint8 num_meas
+RecStat rec_stat
+uint8 version
+RawxData[] rawx_data
+";
+
+/// `ublox_ubx_msgs/UBXRxmSfrbx`.
+pub const UBX_RXM_SFRBX_MSG: &str = "\
+std_msgs/Header header
+uint8 gnss_id
+uint8 sv_id
+uint8 sig_id
+uint8 freq_id
+uint8 num_words
+uint8 chn
+uint8 version
+uint32[] dwrd
+";
+
 /// Every known definition text, keyed by `pkg/Type` (no `msg/` in the middle).
 const DEFINITIONS: &[(&str, &str)] = &[
     ("builtin_interfaces/Time", TIME_MSG),
@@ -155,6 +213,14 @@ const DEFINITIONS: &[(&str, &str)] = &[
     ("tf2_msgs/TFMessage", TF_MESSAGE_MSG),
     ("rosgraph_msgs/Clock", CLOCK_MSG),
     ("rcl_interfaces/Log", LOG_MSG),
+    ("std_msgs/MultiArrayDimension", MULTI_ARRAY_DIMENSION_MSG),
+    ("std_msgs/MultiArrayLayout", MULTI_ARRAY_LAYOUT_MSG),
+    ("std_msgs/UInt8MultiArray", UINT8_MULTI_ARRAY_MSG),
+    ("ublox_ubx_msgs/RecStat", REC_STAT_MSG),
+    ("ublox_ubx_msgs/TrkStat", TRK_STAT_MSG),
+    ("ublox_ubx_msgs/RawxData", RAWX_DATA_MSG),
+    ("ublox_ubx_msgs/UBXRxmRawx", UBX_RXM_RAWX_MSG),
+    ("ublox_ubx_msgs/UBXRxmSfrbx", UBX_RXM_SFRBX_MSG),
     (
         "adaptive_gnss_ins/SatelliteMeasurement",
         SATELLITE_MEASUREMENT_MSG,

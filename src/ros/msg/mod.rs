@@ -1,4 +1,5 @@
-//! Serde structs for the ROS 2 messages the node reads and writes.
+//! Serde structs for the ROS 2 messages the node reads and writes, and those of the u-blox
+//! drivers it reads (`ublox_ubx_msgs`, `std_msgs/UInt8MultiArray`).
 //!
 //! Each struct matches its ROS 2 Jazzy definition field for field, in the same order:
 //! CDR is positional, so the order *is* the wire format. Fixed-size arrays (`float64[9]`,
@@ -11,11 +12,13 @@ mod diagnostic;
 mod fixed_array;
 mod geometry;
 mod gnss;
+mod multi_array;
 mod nav;
 mod rcl;
 mod rosgraph;
 mod sensor;
 mod tf2;
+mod ublox;
 
 pub use builtin::{Header, Time};
 pub use diagnostic::{DiagnosticArray, DiagnosticStatus, KeyValue};
@@ -27,11 +30,13 @@ pub use gnss::{
     GnssMeasurements, NoiseEstimates, SatelliteMeasurement, SatelliteNoise, GNSS_MEASUREMENTS_MSG,
     NOISE_ESTIMATES_MSG, SATELLITE_MEASUREMENT_MSG, SATELLITE_NOISE_MSG,
 };
+pub use multi_array::{MultiArrayDimension, MultiArrayLayout, UInt8MultiArray};
 pub use nav::Odometry;
 pub use rcl::Log;
 pub use rosgraph::Clock;
 pub use sensor::{Imu, NavSatFix, NavSatStatus};
 pub use tf2::TFMessage;
+pub use ublox::{RawxData, RecStat, TrkStat, UbxRxmRawx, UbxRxmSfrbx};
 
 /// A ROS 2 message type and the names it is known by.
 pub trait RosMessage: serde::Serialize + serde::de::DeserializeOwned {
