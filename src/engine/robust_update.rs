@@ -41,7 +41,7 @@ use crate::adaptive::equivalent_covariance::{
 };
 use crate::adaptive::mahalanobis::{chi_square_quantile, mahalanobis_squared};
 use crate::adaptive::predicted_residual::{predicted_residual_statistic, standardized_residuals};
-use crate::config::{AdaptiveFactorKind, Config, EquivalentWeightKind, FilterVariant};
+use crate::config::{AdaptiveFactorKind, Config, EquivalentWeightKind, RobustScheme};
 use crate::filter::cubature::{cubature_measurement_update, Gaussian};
 use crate::filter::ekf::{self, FilterError};
 use crate::ins::error_state::{StateMatrix, StateVector, N};
@@ -76,18 +76,13 @@ pub enum Scheme {
 }
 
 impl Scheme {
-    /// The scheme of a variant.
-    pub fn of(variant: FilterVariant) -> Self {
-        match variant {
-            FilterVariant::AkfAll => Self::AdaptiveAll,
-            FilterVariant::AkfPartial => Self::AdaptivePartial,
-            FilterVariant::Iarf => Self::AdaptivelyRobust,
-            FilterVariant::Ekf
-            | FilterVariant::Eiakf
-            | FilterVariant::Srmakf
-            | FilterVariant::Ermakf
-            | FilterVariant::Ckf
-            | FilterVariant::ResidualAkf => Self::Plain,
+    /// The scheme of a row of the variant table.
+    pub fn of(scheme: RobustScheme) -> Self {
+        match scheme {
+            RobustScheme::Plain => Self::Plain,
+            RobustScheme::AdaptiveAll => Self::AdaptiveAll,
+            RobustScheme::AdaptivePartial => Self::AdaptivePartial,
+            RobustScheme::AdaptivelyRobust => Self::AdaptivelyRobust,
         }
     }
 
@@ -161,7 +156,7 @@ impl RobustUpdate {
         };
         Self {
             cubature: config.filter.uses_cubature(),
-            scheme: Scheme::of(config.filter.variant),
+            scheme: Scheme::of(config.filter.variant.spec().scheme),
             factor: AdaptiveFactorOptions {
                 function,
                 alpha_floor: r.alpha_floor,

@@ -12,7 +12,7 @@ use std::collections::HashMap;
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::config::{Config, FilterVariant};
+use crate::config::{Config, NoiseStrategy};
 use crate::gnss::SatId;
 
 pub use innovation::InnovationNoise;
@@ -81,17 +81,18 @@ pub enum NoiseModel {
 }
 
 impl NoiseModel {
+    /// The strategy of the configured variant's row of the variant table.
     pub fn new(config: &Config) -> Self {
-        match config.filter.variant {
-            FilterVariant::Ekf
-            | FilterVariant::Ckf
-            | FilterVariant::AkfAll
-            | FilterVariant::AkfPartial
-            | FilterVariant::Iarf => Self::Fixed,
-            FilterVariant::ResidualAkf => Self::Residual(Box::new(ResidualNoise::new(config))),
-            FilterVariant::Eiakf => Self::Innovation(Box::new(InnovationNoise::new(config))),
-            FilterVariant::Srmakf => Self::Redundant(Box::new(RedundantNoise::new(config, false))),
-            FilterVariant::Ermakf => Self::Redundant(Box::new(RedundantNoise::new(config, true))),
+        match config.filter.variant.spec().noise {
+            NoiseStrategy::Fixed => Self::Fixed,
+            NoiseStrategy::Innovation => Self::Innovation(Box::new(InnovationNoise::new(config))),
+            NoiseStrategy::RedundantSimple => {
+                Self::Redundant(Box::new(RedundantNoise::new(config, false)))
+            }
+            NoiseStrategy::RedundantEnhanced => {
+                Self::Redundant(Box::new(RedundantNoise::new(config, true)))
+            }
+            NoiseStrategy::Residual => Self::Residual(Box::new(ResidualNoise::new(config))),
         }
     }
 
