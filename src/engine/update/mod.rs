@@ -17,11 +17,25 @@
 //!
 //! Models: [`Pseudoranges`] (tightly coupled: pseudo-ranges and rates of a GNSS epoch) and
 //! [`FixMeasurement`] (loosely coupled: a receiver's position and velocity fix).
+//!
+//! Adding a model (zero velocity, non-holonomic constraint, wheel speed, time-differenced
+//! carrier phase, ...): a file here with a type that borrows the measurement and the
+//! configuration and implements [`MeasurementModel`]; its `linearize` returns the rows of H
+//! (new rows belong in [`crate::filter::measurement_rows`]), the measured and predicted
+//! values and the nominal noise — [`NominalNoise::Joint`] for a vector measurement (the
+//! residual strategy learns one window per [`super::MeasurementKind`]),
+//! [`NominalNoise::PerRow`] with a channel (satellite, observable) per row for
+//! per-satellite scalars, which are also gated; its `predict` predicts chosen rows from any
+//! state. The engine feeds it with one arm of `Engine::apply_measurement`:
+//! `update::apply(state, &mut model, adaptation, learn)`. `tests.rs` holds a zero-velocity
+//! model written this way.
 
 mod fix;
 mod gate;
 mod model;
 mod pseudoranges;
+#[cfg(test)]
+mod tests;
 
 use nalgebra::{DMatrix, DVector};
 
