@@ -1,10 +1,9 @@
 //! The innovation gate of scalar measurements.
 
-use crate::filter::measurement_rows::Row;
+use crate::filter::measurement_rows::{row_variance, Row};
 use crate::ins::error_state::StateMatrix;
 
 use super::super::adaptive_noise::Observable;
-use super::hph;
 
 /// One scalar measurement as the gate sees it.
 pub(super) struct GateRow<'a> {
@@ -54,7 +53,7 @@ pub(super) fn gate(
     }
     let mut kept = Vec::with_capacity(rows.len());
     for (i, g) in rows.iter().enumerate() {
-        let s = hph(g.row, p) + g.r;
+        let s = row_variance(g.row, p) + g.r;
         let offset = offsets
             .iter()
             .find(|(o, _)| *o == g.observable)

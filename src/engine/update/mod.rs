@@ -40,9 +40,9 @@ mod tests;
 use nalgebra::{DMatrix, DVector};
 
 use crate::filter::ekf::FilterError;
-use crate::filter::measurement_rows::Row;
+use crate::filter::measurement_rows::row_variance;
 use crate::filter::robust_update::{ErrorStateModel, MeasurementSet};
-use crate::ins::error_state::{StateMatrix, StateVector, N};
+use crate::ins::error_state::{StateVector, N};
 
 use super::adaptation::Adaptation;
 use super::adaptive_noise::ScalarMeasurement;
@@ -110,7 +110,7 @@ impl<M: MeasurementModel> Step<'_, M> {
                 observable: c.observable,
                 measured: lin.measured[i],
                 predicted: lin.predicted[i],
-                hph: hph(&lin.rows[i], &state.p),
+                hph: row_variance(&lin.rows[i], &state.p),
                 r_nominal: c.r_nominal,
             })
             .collect();
@@ -147,7 +147,10 @@ impl<M: MeasurementModel> Step<'_, M> {
         let noise = &mut self.adaptation.noise;
         if self.learn && noise.wants_posterior_predictions() {
             let posterior_hph: Vec<f64> = if noise.wants_posterior_hph() {
-                lin.rows.iter().map(|row| hph(row, &state.p)).collect()
+                lin.rows
+                    .iter()
+                    .map(|row| row_variance(row, &state.p))
+                    .collect()
             } else {
                 Vec::new()
             };
@@ -227,11 +230,6 @@ impl<M: MeasurementModel> Step<'_, M> {
         }
         Ok(h)
     }
-}
-
-/// h P hᵀ of the row h.
-fn hph(row: &Row, p: &StateMatrix) -> f64 {
-    (row * p * row.transpose())[(0, 0)]
 }
 
 /// The innovations y = predicted − measured of every row.
