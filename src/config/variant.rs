@@ -5,10 +5,11 @@
 //! tools list the variants from it.
 //!
 //! Adding a variant: a value of [`FilterVariant`] and its row of [`VARIANTS`] (in the same
-//! place of both; a compile-time check keeps them in step). A variant made of existing
-//! columns needs nothing else; a new strategy is a new column value and its implementation
-//! in the engine (`engine::adaptive_noise` for a noise strategy, `filter::robust_update` for
-//! a scheme).
+//! place of both; a compile-time check keeps them in step), and its preset
+//! `params/<name>.yaml`. A variant made of existing columns needs no code elsewhere; a new
+//! strategy is a new column value, its implementation (`engine::adaptive_noise` for a noise
+//! strategy, `filter::robust_update` for a scheme) and its arm in the one match that maps
+//! the column (`NoiseModel::new`, `engine::adaptation`).
 
 use std::fmt;
 
@@ -205,7 +206,7 @@ pub const VARIANTS: [VariantSpec; 9] = [
     },
 ];
 
-// Row i of the table describes the value i of the enum, which `FilterVariant::spec` relies on.
+// Row i of the table describes the enum's value i: `FilterVariant::spec` relies on it.
 const _: () = {
     let mut i = 0;
     while i < VARIANTS.len() {

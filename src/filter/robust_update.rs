@@ -11,15 +11,16 @@
 //! The cubature update on the error state: the 2n cubature points are error samples δxᵢ
 //! around 0 drawn from N(0, P⁻); for each, [`ErrorStateModel::predict_corrected`] feeds it
 //! back into a copy of the nominal state and predicts the measurements from that copy, so
-//! the filter sees the full non-linearity of the measurement model. With g(δx) = ŷ(nominal) − ŷ(nominal ⊕ δx) (≈ H δx to first
-//! order, the sign convention of the EKF rows) the measurement of the error is `y` itself.
+//! the filter sees the full non-linearity of the measurement model. With
+//! g(δx) = ŷ(nominal) − ŷ(nominal ⊕ δx) (≈ H δx to first order, the sign convention of the
+//! EKF rows) the measurement of the error is `y` itself.
 //!
 //! Choice (time update of the cubature filter): the covariance is propagated by the same
-//! linearized error dynamics as the EKF (the engine's `FilterState::propagate`). The error dynamics are
-//! linear to first order in the small error, and an IMU-rate cubature time update would cost
-//! 2n = 40 strapdown mechanizations per IMU sample; the IARF paper's non-linearity argument
-//! (section 4) concerns models whose linearization is poor, which for an error state in
-//! closed loop is the measurement side.
+//! linearized error dynamics as the EKF (the engine's `FilterState::propagate`). The error
+//! dynamics are linear to first order in the small error, and an IMU-rate cubature time
+//! update would cost 2n = 40 strapdown mechanizations per IMU sample; the IARF paper's
+//! non-linearity argument (section 4) concerns models whose linearization is poor, which
+//! for an error state in closed loop is the measurement side.
 //!
 //! Choice (posterior): the IARF paper's eq. (16), P⁺ = P⁻ − K̄HP⁻ with the un-inflated P⁻,
 //! computed in Joseph's form (I − K̄H)P⁻(I − K̄H)ᵀ + K̄(αR̄)K̄ᵀ with the linearized rows H
