@@ -4,7 +4,8 @@
 
 use adaptive_gnss_ins::config::{Config, FilterVariant};
 use adaptive_gnss_ins::earth::{self, Llh};
-use adaptive_gnss_ins::engine::{process_noise, tight_update, Adaptation, FilterState};
+use adaptive_gnss_ins::engine::update::{self, Pseudoranges};
+use adaptive_gnss_ins::engine::{process_noise, Adaptation, FilterState};
 use adaptive_gnss_ins::gnss::GnssEpoch;
 use adaptive_gnss_ins::ins::error_state::StateMatrix;
 use adaptive_gnss_ins::ins::{ImuSample, NavState};
@@ -95,15 +96,9 @@ fn tc_update(c: &mut Criterion) {
         b.iter(|| {
             let mut state = start.clone();
             let mut adaptation = adaptation.clone();
-            let report = tight_update::update(
-                &mut state,
-                black_box(&epoch),
-                &w,
-                &config,
-                &mut adaptation,
-                true,
-            )
-            .expect("update");
+            let mut model = Pseudoranges::new(black_box(&epoch), &w, &config);
+            let report =
+                update::apply(&mut state, &mut model, &mut adaptation, true).expect("update");
             assert_eq!(report.measurements_used, 24);
         })
     });
@@ -181,8 +176,8 @@ fn tc_update_adaptive(c: &mut Criterion) {
         let mut adaptation = Adaptation::new(&config);
         // Warm up: fill every window.
         for e in &epochs[..150] {
-            tight_update::update(&mut state, e, &w, &config, &mut adaptation, true)
-                .expect("update");
+            let mut model = Pseudoranges::new(e, &w, &config);
+            update::apply(&mut state, &mut model, &mut adaptation, true).expect("update");
         }
         let mut k = 150usize;
         let name = format!("tc_epoch_12_satellites_{}", variant.as_str());
@@ -192,15 +187,8 @@ fn tc_update_adaptive(c: &mut Criterion) {
                 let mut e = epochs[k % epochs.len()].clone();
                 e.t_s += laps * epochs.len() as f64;
                 k += 1;
-                tight_update::update(
-                    &mut state,
-                    black_box(&e),
-                    &w,
-                    &config,
-                    &mut adaptation,
-                    true,
-                )
-                .expect("update")
+                let mut model = Pseudoranges::new(black_box(&e), &w, &config);
+                update::apply(&mut state, &mut model, &mut adaptation, true).expect("update")
             })
         });
     }

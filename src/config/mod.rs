@@ -27,6 +27,7 @@ mod sections;
 mod spec;
 mod table;
 mod validate;
+mod variant;
 
 use std::collections::HashMap;
 
@@ -42,9 +43,13 @@ pub use parameters::{
     AdaptiveConfig, ClockConfig, Config, EngineConfig, FilterConfig, GnssConfig, ImuConfig,
     InitConfig, LooseConfig, MountingConfig, OutputConfig, RobustConfig,
 };
-pub use sections::{AdaptiveFactorKind, Coupling, EquivalentWeightKind, FilterBase, FilterVariant};
+pub use sections::{AdaptiveFactorKind, Coupling, EquivalentWeightKind};
 pub use spec::{Interval, Kind, Range};
 pub use table::{yaml_text, Parameter};
+pub use variant::{
+    BaseFilter, BaseRule, FilterBase, FilterVariant, NoiseStrategy, RobustScheme, VariantSpec,
+    VARIANTS,
+};
 
 use table::WriteError;
 

@@ -1,7 +1,7 @@
 //! The checks that relate two parameters (each parameter's own range is in the table and
 //! is checked when the value is written). The first offending key is reported.
 
-use super::{Config, FilterBase, FilterVariant};
+use super::Config;
 
 /// A relation between parameters that does not hold: the key to name, its value as the
 /// file writes it, the other key involved (for the origin) and the reason.
@@ -61,12 +61,12 @@ pub fn relations(c: &Config) -> Result<(), Conflict> {
     }
 
     let f = &c.filter;
-    if f.base == FilterBase::Ekf && f.variant == FilterVariant::Ckf {
+    if let Some(reason) = f.variant.base_conflict(f.base) {
         return Err(Conflict {
             key: "filter.base",
-            value: FilterBase::Ekf.as_str().to_owned(),
+            value: f.base.as_str().to_owned(),
             other: "filter.variant",
-            reason: "variant ckf is the cubature filter; use variant ekf for the EKF".to_owned(),
+            reason,
         });
     }
     let r = &c.robust;

@@ -21,8 +21,7 @@ use crate::ins::error_state::{
 };
 use crate::ins::{ImuSample, NavState};
 
-use super::loose_update::GnssFix;
-use super::tight_update::sigma_model;
+use super::update::{sigma_model, GnssFix};
 
 /// What the initializer hands to the engine when it can start the filter.
 #[derive(Debug, Clone, PartialEq)]

@@ -23,13 +23,11 @@ pub mod adaptive_noise;
 mod filter_state;
 pub mod fix_pairing;
 mod initializer;
-pub mod loose_update;
 mod output;
 pub mod q_scaling;
 mod rejection;
 mod retune;
-pub mod robust_update;
-pub mod tight_update;
+pub mod update;
 
 use std::collections::VecDeque;
 
@@ -41,13 +39,13 @@ use crate::ins::ImuSample;
 pub use adaptation::Adaptation;
 pub use filter_state::{interpolate, FilterState};
 pub use initializer::{InitPhase, Initializer};
-pub use loose_update::GnssFix;
 pub use output::{
     EpochReport, MeasurementKind, Output, ResetReason, SatRejection, SatReport, Solution,
     StatusEvent,
 };
 pub use rejection::{InputRejected, RejectionCounters, RejectionReason};
 pub use retune::{NotRuntimeTunable, RUNTIME_PARAMETERS};
+pub use update::GnssFix;
 
 /// A measurement waiting for its time.
 #[derive(Debug, Clone, PartialEq)]
@@ -439,10 +437,12 @@ impl Engine {
                 let adaptation = &mut self.adaptation;
                 let result = match &p.measurement {
                     Measurement::Gnss(e) => {
-                        tight_update::update(state, e, &w, &self.config, adaptation, report)
+                        let mut model = update::Pseudoranges::new(e, &w, &self.config);
+                        update::apply(state, &mut model, adaptation, report)
                     }
                     Measurement::Fix(f) => {
-                        loose_update::update(state, f, &w, &self.config, adaptation, report)
+                        let mut model = update::FixMeasurement::new(f, &w, &self.config, state);
+                        update::apply(state, &mut model, adaptation, report)
                     }
                 };
                 match result {

@@ -3,7 +3,6 @@
 
 use nalgebra::{Matrix3, SMatrix, Vector3};
 
-use crate::config::Config;
 use crate::earth;
 use crate::gnss::SatId;
 use crate::ins::error_state::{StateMatrix, DP, DV, PHI};
@@ -144,7 +143,7 @@ impl SatReport {
 }
 
 /// Kind of measurement an epoch report describes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum MeasurementKind {
     /// Raw pseudo-ranges and rates (tightly coupled).
     Pseudoranges,
@@ -181,12 +180,12 @@ pub struct EpochReport {
 }
 
 impl EpochReport {
-    /// An empty report of the configured variant.
-    pub fn new(t_s: f64, kind: MeasurementKind, config: &Config) -> Self {
+    /// An empty report of the variant named `variant`.
+    pub fn new(t_s: f64, kind: MeasurementKind, variant: &'static str) -> Self {
         Self {
             t_s,
             kind,
-            variant: config.filter.variant.as_str(),
+            variant,
             satellites: Vec::new(),
             measurements_used: 0,
             nis: f64::NAN,

@@ -14,11 +14,16 @@
 use nalgebra::{Matrix3, RowSVector, Vector3};
 
 use crate::earth::{self, Llh};
-use crate::ins::error_state::{CLOCK_BIAS, CLOCK_DRIFT, DP, DV, N, PHI};
+use crate::ins::error_state::{StateMatrix, CLOCK_BIAS, CLOCK_DRIFT, DP, DV, N, PHI};
 use crate::ins::NavState;
 
 /// One row of H.
 pub type Row = RowSVector<f64, N>;
+
+/// h P hᵀ: the variance of the row h's prediction under the error covariance P.
+pub fn row_variance(row: &Row, p: &StateMatrix) -> f64 {
+    (row * p * row.transpose())[(0, 0)]
+}
 
 /// Geometry shared by the rows of one epoch.
 #[derive(Debug, Clone, Copy)]

@@ -11,7 +11,7 @@ use std::path::Path;
 
 use crate::config::Config;
 use crate::earth::{self, Llh};
-use crate::engine::tight_update::sigma_model;
+use crate::engine::update::sigma_model;
 use crate::eval::{self, ErrorSummary, SolutionError, TruthSample, TruthTrack};
 use crate::gnss::spp::{solve_spp, SppConfig};
 use crate::gnss::{Constellation, GnssEpoch};

@@ -12,8 +12,10 @@ use std::collections::HashMap;
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::config::{Config, FilterVariant};
+use crate::config::{Config, NoiseStrategy};
 use crate::gnss::SatId;
+
+use super::output::MeasurementKind;
 
 pub use innovation::InnovationNoise;
 pub use redundant::RedundantNoise;
@@ -81,17 +83,18 @@ pub enum NoiseModel {
 }
 
 impl NoiseModel {
+    /// The strategy of the configured variant's row of the variant table.
     pub fn new(config: &Config) -> Self {
-        match config.filter.variant {
-            FilterVariant::Ekf
-            | FilterVariant::Ckf
-            | FilterVariant::AkfAll
-            | FilterVariant::AkfPartial
-            | FilterVariant::Iarf => Self::Fixed,
-            FilterVariant::ResidualAkf => Self::Residual(Box::new(ResidualNoise::new(config))),
-            FilterVariant::Eiakf => Self::Innovation(Box::new(InnovationNoise::new(config))),
-            FilterVariant::Srmakf => Self::Redundant(Box::new(RedundantNoise::new(config, false))),
-            FilterVariant::Ermakf => Self::Redundant(Box::new(RedundantNoise::new(config, true))),
+        match config.filter.variant.spec().noise {
+            NoiseStrategy::Fixed => Self::Fixed,
+            NoiseStrategy::Innovation => Self::Innovation(Box::new(InnovationNoise::new(config))),
+            NoiseStrategy::RedundantSimple => {
+                Self::Redundant(Box::new(RedundantNoise::new(config, false)))
+            }
+            NoiseStrategy::RedundantEnhanced => {
+                Self::Redundant(Box::new(RedundantNoise::new(config, true)))
+            }
+            NoiseStrategy::Residual => Self::Residual(Box::new(ResidualNoise::new(config))),
         }
     }
 
@@ -142,19 +145,27 @@ impl NoiseModel {
         }
     }
 
-    /// The covariance of a receiver fix (loose coupling). Only the residual-based strategy
-    /// estimates it; the others are per-satellite strategies and give `nominal` back.
-    pub fn fix_covariance(&self, nominal: &DMatrix<f64>) -> DMatrix<f64> {
+    /// The covariance of a measurement whose noise is one matrix (a receiver fix). Only
+    /// the residual-based strategy estimates it, one window per kind of measurement; the
+    /// others are per-satellite strategies and give `nominal` back.
+    pub fn joint_covariance(&self, kind: MeasurementKind, nominal: &DMatrix<f64>) -> DMatrix<f64> {
         match self {
-            Self::Residual(m) => m.fix_covariance(nominal),
+            Self::Residual(m) => m.joint_covariance(kind, nominal),
             Self::Fixed | Self::Innovation(_) | Self::Redundant(_) => nominal.clone(),
         }
     }
 
-    /// Hands over the post-update residual ε = z − H x̂ of a fix and its H P̂ Hᵀ.
-    pub fn after_fix_update(&mut self, t_s: f64, residual: &DVector<f64>, hph: &DMatrix<f64>) {
+    /// Hands over the post-update residual ε = z − H x̂ of such a measurement and its
+    /// H P̂ Hᵀ.
+    pub fn after_joint_update(
+        &mut self,
+        kind: MeasurementKind,
+        t_s: f64,
+        residual: &DVector<f64>,
+        hph: &DMatrix<f64>,
+    ) {
         if let Self::Residual(m) = self {
-            m.after_fix_update(t_s, residual, hph);
+            m.after_joint_update(kind, t_s, residual, hph);
         }
     }
 

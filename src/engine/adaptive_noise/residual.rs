@@ -7,7 +7,8 @@
 //! - Tightly coupled: one scalar estimator per satellite and observable (the satellite set
 //!   changes from epoch to epoch; a joint estimator would restart at every change).
 //!   Loosely coupled: one estimator of the full fix covariance (position, and velocity
-//!   when the fix has one), which keeps the correlations eq. (14) estimates.
+//!   when the fix has one), which keeps the correlations eq. (14) estimates; one such
+//!   estimator per kind of measurement whose noise is one matrix.
 //! - The estimate of the epochs before is used at the current epoch (eq. (14) needs the
 //!   posterior of the epoch itself, so it cannot be used in that epoch's own update); until
 //!   a window is full the nominal R is used. Estimated pseudo-range variances stay within
@@ -16,6 +17,7 @@
 //!   after a roll-back), and a satellite unseen for longer than `adaptive.max_epoch_gap_s`
 //!   starts a new window.
 
+use std::collections::hash_map::Entry;
 use std::collections::HashMap;
 
 use nalgebra::{DMatrix, DVector};
@@ -24,6 +26,7 @@ use crate::adaptive::residual_r::{ResidualCovarianceEstimator, ResidualCovarianc
 use crate::config::Config;
 use crate::gnss::SatId;
 
+use super::super::output::MeasurementKind;
 use super::{track_for, NoiseVerdict, Observable, ScalarMeasurement, VarianceBounds};
 
 #[derive(Debug, Clone)]
@@ -39,7 +42,7 @@ pub struct ResidualNoise {
     bounds: VarianceBounds,
     max_gap_s: f64,
     tracks: HashMap<(SatId, Observable), Track>,
-    fix: Option<Track>,
+    joint: HashMap<MeasurementKind, Track>,
 }
 
 impl ResidualNoise {
@@ -54,7 +57,7 @@ impl ResidualNoise {
             bounds: VarianceBounds::new(config),
             max_gap_s: config.adaptive.max_epoch_gap_s,
             tracks: HashMap::new(),
-            fix: None,
+            joint: HashMap::new(),
         }
     }
 
@@ -110,35 +113,43 @@ impl ResidualNoise {
         }
     }
 
-    /// The covariance of a receiver fix: the window's estimate when full and of the same
-    /// dimension, else `nominal`.
-    pub fn fix_covariance(&self, nominal: &DMatrix<f64>) -> DMatrix<f64> {
-        self.fix
-            .as_ref()
+    /// The covariance of a measurement of `kind` whose noise is one matrix: the window's
+    /// estimate when full and of the same dimension, else `nominal`.
+    pub fn joint_covariance(&self, kind: MeasurementKind, nominal: &DMatrix<f64>) -> DMatrix<f64> {
+        self.joint
+            .get(&kind)
             .and_then(|t| t.estimator.estimate())
             .filter(|r| r.nrows() == nominal.nrows())
             .unwrap_or_else(|| nominal.clone())
     }
 
-    /// Learns from the post-update residual ε = z − H x̂ of a fix and its H P̂ Hᵀ.
-    pub fn after_fix_update(&mut self, t_s: f64, residual: &DVector<f64>, hph: &DMatrix<f64>) {
-        if self.fix.is_none() {
-            let Ok(estimator) = ResidualCovarianceEstimator::new(self.options) else {
-                return;
-            };
-            self.fix = Some(Track {
-                estimator,
-                last_t_s: f64::NEG_INFINITY,
-            });
-        }
-        if let Some(track) = self.fix.as_mut() {
-            learn(track, t_s, self.max_gap_s, |e| e.push(residual, hph));
-        }
+    /// Learns from the post-update residual ε = z − H x̂ of such a measurement and its
+    /// H P̂ Hᵀ.
+    pub fn after_joint_update(
+        &mut self,
+        kind: MeasurementKind,
+        t_s: f64,
+        residual: &DVector<f64>,
+        hph: &DMatrix<f64>,
+    ) {
+        let track = match self.joint.entry(kind) {
+            Entry::Occupied(e) => e.into_mut(),
+            Entry::Vacant(e) => {
+                let Ok(estimator) = ResidualCovarianceEstimator::new(self.options) else {
+                    return;
+                };
+                e.insert(Track {
+                    estimator,
+                    last_t_s: f64::NEG_INFINITY,
+                })
+            }
+        };
+        learn(track, t_s, self.max_gap_s, |e| e.push(residual, hph));
     }
 
     pub fn reset(&mut self) {
         self.tracks.clear();
-        self.fix = None;
+        self.joint.clear();
     }
 }
 

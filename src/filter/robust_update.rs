@@ -1,25 +1,26 @@
-//! The measurement update shared by the tightly- and loosely-coupled paths: the base filter
-//! (EKF or cubature) and the schemes of the IARF paper (Jiang & Zhang 2018, Sensors 18:695)
-//! on top of it — the adaptive factor α of the predicted residual (sections 2.1–2.2), the
-//! robust equivalent covariance R̄ (section 3) and the Mahalanobis test that switches them
-//! (section 3).
+//! The measurement update of every measurement model: the base filter (EKF or cubature) and
+//! the schemes of the IARF paper (Jiang & Zhang 2018, Sensors 18:695) on top of it — the
+//! adaptive factor α of the predicted residual (sections 2.1–2.2), the robust equivalent
+//! covariance R̄ (section 3) and the Mahalanobis test that switches them (section 3). It
+//! takes plain options and matrices; the caller feeds the correction back.
 //!
 //! Conventions: the error state is zero before the update (closed-loop feedback), `y` is
-//! predicted − measured, and the correction δx̂ is fed back by
-//! [`FilterState::apply_correction`].
+//! predicted − measured, and the result is the correction δx̂ and the posterior covariance,
+//! which the caller feeds back into its nominal state.
 //!
 //! The cubature update on the error state: the 2n cubature points are error samples δxᵢ
-//! around 0 drawn from N(0, P⁻); each is fed back into a copy of the nominal state and the
-//! measurements are predicted from that copy, so the filter sees the full non-linearity of
-//! the measurement model. With g(δx) = ŷ(nominal) − ŷ(nominal ⊕ δx) (≈ H δx to first
-//! order, the sign convention of the EKF rows) the measurement of the error is `y` itself.
+//! around 0 drawn from N(0, P⁻); for each, [`ErrorStateModel::predict_corrected`] feeds it
+//! back into a copy of the nominal state and predicts the measurements from that copy, so
+//! the filter sees the full non-linearity of the measurement model. With
+//! g(δx) = ŷ(nominal) − ŷ(nominal ⊕ δx) (≈ H δx to first order, the sign convention of the
+//! EKF rows) the measurement of the error is `y` itself.
 //!
 //! Choice (time update of the cubature filter): the covariance is propagated by the same
-//! linearized error dynamics as the EKF (`FilterState::propagate`). The error dynamics are
-//! linear to first order in the small error, and an IMU-rate cubature time update would cost
-//! 2n = 40 strapdown mechanizations per IMU sample; the IARF paper's non-linearity argument
-//! (section 4) concerns models whose linearization is poor, which for an error state in
-//! closed loop is the measurement side.
+//! linearized error dynamics as the EKF (the engine's `FilterState::propagate`). The error
+//! dynamics are linear to first order in the small error, and an IMU-rate cubature time
+//! update would cost 2n = 40 strapdown mechanizations per IMU sample; the IARF paper's
+//! non-linearity argument (section 4) concerns models whose linearization is poor, which
+//! for an error state in closed loop is the measurement side.
 //!
 //! Choice (posterior): the IARF paper's eq. (16), P⁺ = P⁻ − K̄HP⁻ with the un-inflated P⁻,
 //! computed in Joseph's form (I − K̄H)P⁻(I − K̄H)ᵀ + K̄(αR̄)K̄ᵀ with the linearized rows H
@@ -35,19 +36,26 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::adaptive::adaptive_factor::{AdaptiveFactorFunction, AdaptiveFactorOptions};
+use crate::adaptive::adaptive_factor::AdaptiveFactorOptions;
 use crate::adaptive::equivalent_covariance::{
-    equivalent_measurement_covariance, EquivalentWeightFunction, EquivalentWeightOptions,
+    equivalent_measurement_covariance, EquivalentWeightOptions,
 };
 use crate::adaptive::mahalanobis::{chi_square_quantile, mahalanobis_squared};
 use crate::adaptive::predicted_residual::{predicted_residual_statistic, standardized_residuals};
-use crate::config::{AdaptiveFactorKind, Config, EquivalentWeightKind, FilterVariant};
 use crate::filter::cubature::{cubature_measurement_update, Gaussian};
 use crate::filter::ekf::{self, FilterError};
 use crate::ins::error_state::{StateMatrix, StateVector, N};
 use crate::linalg::{symmetrize, SpdFactor, EIGEN_FLOOR};
 
-use super::filter_state::FilterState;
+/// The predicted measurements of the nominal state, alone and corrected by an error δx:
+/// the measurement function the cubature base evaluates at its points.
+pub trait ErrorStateModel {
+    /// The predictions (m) of the nominal state; None when a prediction fails.
+    fn predict_nominal(&self) -> Option<DVector<f64>>;
+    /// The predictions (m) of the nominal state with the error `dx` fed back; None when a
+    /// prediction fails.
+    fn predict_corrected(&self, dx: &StateVector) -> Option<DVector<f64>>;
+}
 
 /// The measurements of one update, linearized at the nominal state, and their model.
 pub struct MeasurementSet<'a> {
@@ -57,54 +65,44 @@ pub struct MeasurementSet<'a> {
     pub y: DVector<f64>,
     /// Measurement covariance R (m × m) of the noise strategy.
     pub r: DMatrix<f64>,
-    /// The predicted measurements (m, same order as `y`) of a state; None when a prediction
-    /// fails. Used by the cubature base, which evaluates it at every cubature point.
-    pub predict: &'a dyn Fn(&FilterState) -> Option<DVector<f64>>,
+    /// The predictions in the order of `y`, used by the cubature base only.
+    pub model: &'a dyn ErrorStateModel,
 }
 
 /// Which IARF-paper scheme runs on the base filter (section 5).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Scheme {
-    /// No adaptive factor, no robust step (`ekf`, `ckf` and the R-estimating variants).
+    /// No adaptive factor, no robust step (scheme 1 on the cubature base).
     Plain,
-    /// Adaptive factor at every epoch (`akf_all`).
+    /// Adaptive factor at every epoch (scheme 2).
     AdaptiveAll,
-    /// Adaptive factor at the epochs passing the Mahalanobis test (`akf_partial`).
+    /// Adaptive factor at the epochs passing the Mahalanobis test (scheme 3).
     AdaptivePartial,
-    /// Robust R̄ at every epoch, adaptive factor at the epochs passing the test (`iarf`).
+    /// Robust R̄ at every epoch, adaptive factor at the epochs passing the test (scheme 4).
     AdaptivelyRobust,
 }
 
 impl Scheme {
-    /// The scheme of a variant.
-    pub fn of(variant: FilterVariant) -> Self {
-        match variant {
-            FilterVariant::AkfAll => Self::AdaptiveAll,
-            FilterVariant::AkfPartial => Self::AdaptivePartial,
-            FilterVariant::Iarf => Self::AdaptivelyRobust,
-            FilterVariant::Ekf
-            | FilterVariant::Eiakf
-            | FilterVariant::Srmakf
-            | FilterVariant::Ermakf
-            | FilterVariant::Ckf
-            | FilterVariant::ResidualAkf => Self::Plain,
-        }
-    }
-
     fn tests_mahalanobis(self) -> bool {
         matches!(self, Self::AdaptivePartial | Self::AdaptivelyRobust)
     }
 }
 
-/// The configured update: base filter, scheme and their constants.
+/// The update: base filter, scheme and their constants.
 #[derive(Debug, Clone)]
 pub struct RobustUpdate {
-    cubature: bool,
-    scheme: Scheme,
-    factor: AdaptiveFactorOptions,
-    weights: EquivalentWeightOptions,
-    chi2_confidence: f64,
-    joseph: bool,
+    /// The cubature base (else the EKF).
+    pub cubature: bool,
+    pub scheme: Scheme,
+    /// The adaptive factor α of the adaptive schemes.
+    pub factor: AdaptiveFactorOptions,
+    /// The equivalent weights of the robust scheme.
+    pub weights: EquivalentWeightOptions,
+    /// Confidence of the χ² test of the Mahalanobis distance.
+    pub chi2_confidence: f64,
+    /// Joseph's form in the plain EKF (the other combinations always use it, see the
+    /// module documentation).
+    pub joseph: bool,
 }
 
 /// What an update produced, for the report and the estimators that learn from it.
@@ -130,6 +128,16 @@ pub struct UpdateOutcome {
     pub robust_weights: DVector<f64>,
 }
 
+/// The result of an update: the correction to feed back and the posterior covariance.
+#[derive(Debug, Clone)]
+pub struct Correction {
+    /// Error-state estimate δx̂.
+    pub dx: StateVector,
+    /// Posterior covariance.
+    pub p: StateMatrix,
+    pub outcome: UpdateOutcome,
+}
+
 /// Innovation, its covariance and the cross covariance of a prior.
 struct Moments {
     innovation: DVector<f64>,
@@ -138,60 +146,9 @@ struct Moments {
 }
 
 impl RobustUpdate {
-    /// The update of the configuration.
-    pub fn new(config: &Config) -> Self {
-        let r = &config.robust;
-        let function = match r.adaptive_factor_function {
-            AdaptiveFactorKind::TwoSegment => AdaptiveFactorFunction::TwoSegment {
-                c: r.adaptive_factor_c,
-            },
-            AdaptiveFactorKind::ThreeSegment => AdaptiveFactorFunction::ThreeSegment {
-                c0: r.adaptive_factor_c0,
-                c1: r.adaptive_factor_c1,
-            },
-        };
-        let weight_function = match r.equivalent_weight_function {
-            EquivalentWeightKind::DoubleFactor => EquivalentWeightFunction::DoubleFactor {
-                c: r.double_factor_c,
-            },
-            EquivalentWeightKind::Igg3 => EquivalentWeightFunction::Igg3 {
-                k0: r.igg3_k0,
-                k1: r.igg3_k1,
-            },
-        };
-        Self {
-            cubature: config.filter.uses_cubature(),
-            scheme: Scheme::of(config.filter.variant),
-            factor: AdaptiveFactorOptions {
-                function,
-                alpha_floor: r.alpha_floor,
-            },
-            weights: EquivalentWeightOptions {
-                function: weight_function,
-                max_variance_inflation: r.max_variance_inflation,
-            },
-            chi2_confidence: r.chi2_confidence,
-            joseph: config.filter.joseph_form,
-        }
-    }
-
-    /// True when the cubature base runs.
-    pub fn uses_cubature(&self) -> bool {
-        self.cubature
-    }
-
-    /// The scheme in use.
-    pub fn scheme(&self) -> Scheme {
-        self.scheme
-    }
-
-    /// Updates `state` with `set` and feeds the correction back. On an error the state is
-    /// unchanged.
-    pub fn update(
-        &self,
-        state: &mut FilterState,
-        set: &MeasurementSet,
-    ) -> Result<UpdateOutcome, FilterError> {
+    /// Updates the prior covariance `p` with `set`: the correction and the posterior, or an
+    /// error (then nothing is to be fed back).
+    pub fn update(&self, p: &StateMatrix, set: &MeasurementSet) -> Result<Correction, FilterError> {
         let m = set.y.len();
         if set.h.nrows() != m || set.h.ncols() != N || set.r.nrows() != m || set.r.ncols() != m {
             return Err(FilterError::DimensionMismatch {
@@ -203,13 +160,13 @@ impl RobustUpdate {
             });
         }
         if !self.cubature && self.scheme == Scheme::Plain {
-            return self.plain_ekf(state, set);
+            return self.plain_ekf(p, set);
         }
-        let mut prior = DMatrix::from_column_slice(N, N, state.p.as_slice());
+        let mut prior = DMatrix::from_column_slice(N, N, p.as_slice());
         if self.cubature {
             prior = covariance_for_cubature(&prior)?;
         }
-        let nominal = self.moments(state, &prior, set, &set.r)?;
+        let nominal = self.moments(&prior, set, &set.r)?;
         let hph = symmetrize(&(&nominal.s - &set.r));
         let mut outcome = UpdateOutcome {
             innovation: nominal.innovation.clone(),
@@ -260,7 +217,7 @@ impl RobustUpdate {
             // and R̄ = D R D is a congruence of R; both are symmetrised before use.
             let inflated = symmetrize(&prior) / alpha;
             let r_used = r_bar.unwrap_or_else(|| set.r.clone());
-            self.moments(state, &inflated, set, &r_used)?
+            self.moments(&inflated, set, &r_used)?
         };
         let factor = SpdFactor::new("innovation covariance", &moments.s)?;
         let gain = factor.solve(&moments.pxz.transpose()).transpose();
@@ -284,25 +241,21 @@ impl RobustUpdate {
         {
             return Err(FilterError::NonFinite);
         }
-        state.p = posterior;
-        state.apply_correction(&dx);
         outcome.s = moments.s;
         outcome.innovation = moments.innovation;
         outcome.nis = nis;
-        Ok(outcome)
+        Ok(Correction {
+            dx,
+            p: posterior,
+            outcome,
+        })
     }
 
     /// The EKF of [`ekf::update`], unchanged (with its Joseph option).
-    fn plain_ekf(
-        &self,
-        state: &mut FilterState,
-        set: &MeasurementSet,
-    ) -> Result<UpdateOutcome, FilterError> {
-        let result = ekf::update(&state.p, &set.h, &set.y, &set.r, self.joseph)?;
-        state.p = result.p;
-        state.apply_correction(&result.dx);
+    fn plain_ekf(&self, p: &StateMatrix, set: &MeasurementSet) -> Result<Correction, FilterError> {
+        let result = ekf::update(p, &set.h, &set.y, &set.r, self.joseph)?;
         let m = set.y.len();
-        Ok(UpdateOutcome {
+        let outcome = UpdateOutcome {
             innovation: set.y.clone(),
             hph: symmetrize(&(&result.s - &set.r)),
             s: result.s,
@@ -312,13 +265,17 @@ impl RobustUpdate {
             mahalanobis_d2: f64::NAN,
             chi2_threshold: f64::NAN,
             robust_weights: DVector::from_element(m, f64::NAN),
+        };
+        Ok(Correction {
+            dx: result.dx,
+            p: result.p,
+            outcome,
         })
     }
 
     /// Innovation, S and P_xz of the prior covariance `p` and the noise `r`.
     fn moments(
         &self,
-        state: &FilterState,
         p: &DMatrix<f64>,
         set: &MeasurementSet,
         r: &DMatrix<f64>,
@@ -333,14 +290,13 @@ impl RobustUpdate {
             });
         }
         let m = set.y.len();
-        let nominal = (set.predict)(state).ok_or(FilterError::NonFinite)?;
+        let nominal = set.model.predict_nominal().ok_or(FilterError::NonFinite)?;
         if nominal.len() != m {
             return Err(FilterError::NonFinite);
         }
         let g = |e: &DVector<f64>| {
-            let mut copy = state.clone();
-            copy.apply_correction(&StateVector::from_column_slice(e.as_slice()));
-            match (set.predict)(&copy) {
+            let dx = StateVector::from_column_slice(e.as_slice());
+            match set.model.predict_corrected(&dx) {
                 Some(predicted) if predicted.len() == m => &nominal - predicted,
                 _ => DVector::from_element(m, f64::NAN),
             }

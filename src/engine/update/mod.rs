@@ -1,0 +1,290 @@
+//! The measurement update: one shared adaptation step ([`apply`]) around a measurement
+//! model (the pattern of open_vins' `update/`: one updater per measurement type around one
+//! shared EKF update).
+//!
+//! A measurement model ([`MeasurementModel`]) knows its measurement: it screens it,
+//! predicts it from a state, gives its rows of H and its nominal noise, and writes its own
+//! fields of the report. The step does what every model shares, in this order:
+//! 1. the variant's noise strategy turns the nominal noise into the R of the update
+//!    (per scalar measurement and channel, or for the whole measurement at once);
+//! 2. the innovation gate (scalar measurements);
+//! 3. the update of the variant's base filter and scheme ([`crate::filter::robust_update`])
+//!    and the feedback of its correction;
+//! 4. the report's common fields, and the process-noise scaling learns from the innovation;
+//! 5. the noise strategy learns from the corrected state's predictions or residuals.
+//!
+//! Nothing learns from a measurement re-applied after a roll-back (`learn` false).
+//!
+//! Models: [`Pseudoranges`] (tightly coupled: pseudo-ranges and rates of a GNSS epoch) and
+//! [`FixMeasurement`] (loosely coupled: a receiver's position and velocity fix).
+//!
+//! Adding a model (zero velocity, non-holonomic constraint, wheel speed, time-differenced
+//! carrier phase, ...): a file here with a type that borrows the measurement and the
+//! configuration and implements [`MeasurementModel`]; its `linearize` returns the rows of H
+//! (new rows belong in [`crate::filter::measurement_rows`]), the measured and predicted
+//! values and the nominal noise — [`NominalNoise::Joint`] for a vector measurement (the
+//! residual strategy learns one window per [`super::MeasurementKind`]),
+//! [`NominalNoise::PerRow`] with a channel (satellite, observable) per row for
+//! per-satellite scalars, which are also gated; its `predict` predicts chosen rows from any
+//! state. The engine feeds it with one arm of `Engine::apply_measurement`:
+//! `update::apply(state, &mut model, adaptation, learn)`. `tests.rs` holds a zero-velocity
+//! model written this way.
+
+mod fix;
+mod gate;
+mod model;
+mod pseudoranges;
+#[cfg(test)]
+mod tests;
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::filter::ekf::FilterError;
+use crate::filter::measurement_rows::row_variance;
+use crate::filter::robust_update::{ErrorStateModel, MeasurementSet};
+use crate::ins::error_state::{StateVector, N};
+
+use super::adaptation::Adaptation;
+use super::adaptive_noise::ScalarMeasurement;
+use super::filter_state::FilterState;
+use super::output::EpochReport;
+use gate::{gate, GateRow};
+
+pub use fix::{FixMeasurement, GnssFix};
+pub use model::{Linearization, MeasurementModel, NoiseChannel, NominalNoise};
+pub use pseudoranges::{sigma_model, Pseudoranges};
+
+/// Updates `state` with the measurement of `model`; `adaptation` gives the variances and
+/// the update and learns from the measurement unless `learn` is false. Returns the report;
+/// on a filter failure the error (the state may hold a corrected clock: the caller restores
+/// it).
+pub fn apply<M: MeasurementModel>(
+    state: &mut FilterState,
+    model: &mut M,
+    adaptation: &mut Adaptation,
+    learn: bool,
+) -> Result<EpochReport, FilterError> {
+    let mut report = EpochReport::new(model.t_s(), model.kind(), adaptation.variant);
+    let lin = model.linearize(state, &mut report);
+    let mut step = Step {
+        model: &*model,
+        adaptation,
+        learn,
+        report,
+    };
+    match &lin.noise {
+        NominalNoise::PerRow {
+            channels,
+            gate_sigma,
+        } => step.scalars(state, &lin, channels, *gate_sigma)?,
+        NominalNoise::Joint(r) => step.joint(state, &lin, r)?,
+    }
+    Ok(step.report)
+}
+
+/// One measurement on its way through the step.
+struct Step<'a, M> {
+    model: &'a M,
+    adaptation: &'a mut Adaptation,
+    learn: bool,
+    report: EpochReport,
+}
+
+impl<M: MeasurementModel> Step<'_, M> {
+    /// Independent scalar measurements: a variance and a gate each, and the noise strategy
+    /// learns from each one's prediction by the corrected state.
+    fn scalars(
+        &mut self,
+        state: &mut FilterState,
+        lin: &Linearization,
+        channels: &[NoiseChannel],
+        gate_sigma: f64,
+    ) -> Result<(), FilterError> {
+        let t_s = self.model.t_s();
+        let m = lin.rows.len();
+        let scalars: Vec<ScalarMeasurement> = channels
+            .iter()
+            .enumerate()
+            .map(|(i, c)| ScalarMeasurement {
+                sat: c.sat,
+                observable: c.observable,
+                measured: lin.measured[i],
+                predicted: lin.predicted[i],
+                hph: row_variance(&lin.rows[i], &state.p),
+                r_nominal: c.r_nominal,
+            })
+            .collect();
+        let verdicts = self.adaptation.noise.variances(t_s, &scalars, self.learn);
+        let mut r = Vec::with_capacity(m);
+        for (i, verdict) in verdicts.iter().enumerate() {
+            r.push(verdict.r);
+            self.model.report_noise(&mut self.report, i, verdict);
+        }
+        let y = innovations(lin);
+        let gate_rows: Vec<GateRow> = (0..m)
+            .map(|i| GateRow {
+                row: &lin.rows[i],
+                observable: channels[i].observable,
+                y: y[i],
+                r: r[i],
+            })
+            .collect();
+        let (model, report) = (self.model, &mut self.report);
+        let kept = gate(
+            &gate_rows,
+            &state.p,
+            gate_sigma,
+            |i, innovation, normalized| model.report_gated(report, i, innovation, normalized),
+        );
+        self.report.q_scale = self.adaptation.q.scale();
+        if !kept.is_empty() {
+            let mut r_kept = DMatrix::zeros(kept.len(), kept.len());
+            for (j, &i) in kept.iter().enumerate() {
+                r_kept[(j, j)] = r[i];
+            }
+            self.correct(state, Rows::select(lin, &y, &kept), r_kept)?;
+        }
+        let noise = &mut self.adaptation.noise;
+        if self.learn && noise.wants_posterior_predictions() {
+            let posterior_hph: Vec<f64> = if noise.wants_posterior_hph() {
+                lin.rows
+                    .iter()
+                    .map(|row| row_variance(row, &state.p))
+                    .collect()
+            } else {
+                Vec::new()
+            };
+            let every: Vec<usize> = (0..m).collect();
+            let posterior = self.model.predict(state, &every);
+            noise.after_update(t_s, &scalars, posterior.as_slice(), &posterior_hph);
+        }
+        Ok(())
+    }
+
+    /// A measurement whose noise is one matrix: updated as a whole, and the noise strategy
+    /// learns from its post-update residual.
+    fn joint(
+        &mut self,
+        state: &mut FilterState,
+        lin: &Linearization,
+        r_nominal: &DMatrix<f64>,
+    ) -> Result<(), FilterError> {
+        let kind = self.model.kind();
+        let r = self.adaptation.noise.joint_covariance(kind, r_nominal);
+        self.report.q_scale = self.adaptation.q.scale();
+        let every: Vec<usize> = (0..lin.rows.len()).collect();
+        if every.is_empty() {
+            return Ok(());
+        }
+        let h = self.correct(state, Rows::select(lin, &innovations(lin), &every), r)?;
+        if self.learn {
+            let measured = DVector::from_column_slice(&lin.measured);
+            let residual = -(self.model.predict(state, &every) - measured);
+            let p = DMatrix::from_column_slice(N, N, state.p.as_slice());
+            let hph = &h * p * h.transpose();
+            let hph = (&hph + hph.transpose()) * 0.5;
+            let t_s = self.model.t_s();
+            self.adaptation
+                .noise
+                .after_joint_update(kind, t_s, &residual, &hph);
+        }
+        Ok(())
+    }
+
+    /// The update of the variant's base filter and scheme with `rows` and their covariance
+    /// `r`, its feedback into `state`, the report of it, and the process-noise scaling's
+    /// learning. Returns H.
+    fn correct(
+        &mut self,
+        state: &mut FilterState,
+        rows: Rows,
+        r: DMatrix<f64>,
+    ) -> Result<DMatrix<f64>, FilterError> {
+        let predictions = Predictions {
+            state: &*state,
+            model: self.model,
+            rows: &rows.indices,
+        };
+        let set = MeasurementSet {
+            h: rows.h,
+            y: rows.y,
+            r,
+            model: &predictions,
+        };
+        let correction = self.adaptation.update.update(&state.p, &set)?;
+        let h = set.h;
+        state.p = correction.p;
+        state.apply_correction(&correction.dx);
+        let outcome = &correction.outcome;
+        let report = &mut self.report;
+        self.model.report_update(report, &rows.indices, outcome);
+        report.measurements_used = rows.indices.len();
+        report.nis = outcome.nis;
+        report.adaptive_factor = outcome.adaptive_factor;
+        report.mahalanobis_d2 = outcome.mahalanobis_d2;
+        report.chi2_threshold = outcome.chi2_threshold;
+        if self.learn {
+            self.adaptation
+                .q
+                .push(&outcome.innovation, &outcome.r, &outcome.hph);
+        }
+        Ok(h)
+    }
+}
+
+/// The innovations y = predicted − measured of every row.
+fn innovations(lin: &Linearization) -> Vec<f64> {
+    lin.predicted
+        .iter()
+        .zip(&lin.measured)
+        .map(|(predicted, measured)| predicted - measured)
+        .collect()
+}
+
+/// The rows of the linearization that go into the update.
+struct Rows {
+    /// Their indices in the linearization.
+    indices: Vec<usize>,
+    h: DMatrix<f64>,
+    y: DVector<f64>,
+}
+
+impl Rows {
+    fn select(lin: &Linearization, y: &[f64], indices: &[usize]) -> Self {
+        let mut h = DMatrix::zeros(indices.len(), N);
+        let mut y_used = DVector::zeros(indices.len());
+        for (j, &i) in indices.iter().enumerate() {
+            h.row_mut(j).copy_from(&lin.rows[i]);
+            y_used[j] = y[i];
+        }
+        Self {
+            indices: indices.to_vec(),
+            h,
+            y: y_used,
+        }
+    }
+}
+
+/// A model's predictions of some of its rows, from the nominal state and from it corrected
+/// by an error sample: what the cubature base evaluates.
+struct Predictions<'a, M> {
+    state: &'a FilterState,
+    model: &'a M,
+    rows: &'a [usize],
+}
+
+impl<M: MeasurementModel> ErrorStateModel for Predictions<'_, M> {
+    fn predict_nominal(&self) -> Option<DVector<f64>> {
+        all_finite(self.model.predict(self.state, self.rows))
+    }
+
+    fn predict_corrected(&self, dx: &StateVector) -> Option<DVector<f64>> {
+        let mut corrected = self.state.clone();
+        corrected.apply_correction(dx);
+        all_finite(self.model.predict(&corrected, self.rows))
+    }
+}
+
+fn all_finite(values: DVector<f64>) -> Option<DVector<f64>> {
+    values.iter().all(|v| v.is_finite()).then_some(values)
+}
