@@ -13,14 +13,15 @@ use adaptive_gnss_ins::ros::bag::{BagReader, BagWriteOptions, BagWriter};
 use adaptive_gnss_ins::ros::msg::{
     DiagnosticArray, GnssMeasurements, Imu, NavSatFix, NoiseEstimates, Odometry, RosMessage,
 };
+use adaptive_gnss_ins::tools::bag_run::BagRun;
 use adaptive_gnss_ins::tools::replay::TruthSource;
-use adaptive_gnss_ins::tools::replay::{replay, ReplayError, ReplayOptions, ReplayResult};
+use adaptive_gnss_ins::tools::replay::{replay, ReplayError, ReplayOptions};
 
 fn fixture_bag() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/fixture_small.mcap")
 }
 
-fn replay_bag(bag: &Path) -> Result<ReplayResult, ReplayError> {
+fn replay_bag(bag: &Path) -> Result<BagRun, ReplayError> {
     replay(
         bag,
         &Config::default(),

@@ -6,7 +6,11 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::msg::{GnssMeasurements, Imu, SatelliteMeasurement, Time, TwistWithCovarianceStamped};
+use super::msg::{
+    GnssMeasurements, Imu, NavSatFix, SatelliteMeasurement, Time, TwistWithCovarianceStamped,
+};
+use crate::earth::Llh;
+use crate::engine::GnssFix;
 use crate::gnss::{Constellation, GnssEpoch, Klobuchar, SatId, SatObservation};
 use crate::ins::ImuSample;
 
@@ -84,6 +88,43 @@ pub enum ConvertError {
         /// Name of the field in `geometry_msgs/TwistWithCovariance`.
         field: &'static str,
     },
+    /// A NavSatFix whose status says the receiver has no solution.
+    #[error("NavSatFix at {t_s} s: status {status}, no solution")]
+    NoFix {
+        /// Stamp of the fix (s).
+        t_s: f64,
+        /// `status.status` (below `STATUS_FIX`, 0).
+        status: i8,
+    },
+}
+
+/// A receiver fix from a NavSatFix with a solution (`status.status` ≥ 0). The position
+/// covariance is taken as ENU (REP-145 and sensor_msgs); with `COVARIANCE_TYPE_UNKNOWN`
+/// there is none and the configured σ applies. The velocity joins later (see
+/// [`crate::ros::fix_velocity`]). Non-finite values pass: the engine rejects and counts
+/// them.
+impl TryFrom<&NavSatFix> for GnssFix {
+    type Error = ConvertError;
+
+    fn try_from(msg: &NavSatFix) -> Result<Self, Self::Error> {
+        let t_s = time_to_seconds(&msg.header.stamp)?;
+        if msg.status.status < 0 {
+            return Err(ConvertError::NoFix {
+                t_s,
+                status: msg.status.status,
+            });
+        }
+        let c = &msg.position_covariance;
+        let covariance = (msg.position_covariance_type != NavSatFix::COVARIANCE_TYPE_UNKNOWN)
+            .then(|| Matrix3::from_fn(|r, k| c[3 * r + k]));
+        Ok(GnssFix {
+            t_s,
+            position: Llh::from_degrees(msg.latitude, msg.longitude, msg.altitude),
+            position_covariance_enu_m2: covariance,
+            velocity_enu_mps: None,
+            velocity_covariance_enu_m2_s2: None,
+        })
+    }
 }
 
 /// A receiver's velocity (`gnss/velocity`), waiting to join the fix of its stamp.

@@ -2,25 +2,25 @@
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 use clap::{Subcommand, ValueEnum};
 
-use crate::config::{Config, FilterVariant};
+use crate::config::{Config, Coupling, FilterVariant};
+use crate::ros::adapter::{OutputFrames, TIME_JUMP_BACK_S};
 use crate::sim::{Scenario, ScenarioSpec};
 
+use super::bag_run::BagRun;
 use super::cli_play::{self, PlayArgs};
 use super::cli_real::{self, ConvertArgs, SppArgs, SppRinexArgs};
 use super::compare::{
-    format_csv, format_environment_table, format_table, ComparisonRow, EnvironmentRow,
+    compare_bag, format_csv, format_environment_table, format_table, ComparisonRow, EnvironmentRow,
+    NamedConfig,
 };
 use super::plots::{write_plots, FilterRun};
 use super::replay::{self, ReplayOptions, TruthSource};
-use super::session::{Session, SessionReport};
 use super::simulate::{self, TRUTH_TOPIC};
 
-/// Scoring interval of the comparisons (s): every reference sample of a simulated bag
-/// (10 Hz).
+/// Scoring interval of a replay (s): every solution that has a reference.
 const SCORE_INTERVAL_S: f64 = 0.0;
 
 #[derive(Subcommand)]
@@ -153,6 +153,9 @@ pub fn run(command: Command) -> Result<(), String> {
                 out_bag: out.as_deref(),
                 csv: csv.as_deref(),
                 score_interval_s: SCORE_INTERVAL_S,
+                // Choice: the node's default frames until replay reads the node's
+                // parameters (`map_frame`, `base_frame`, `publish_tf`) from its file.
+                frames: OutputFrames::default(),
             };
             let show = std::io::stderr().is_terminal();
             let result = replay::replay(&bag, &config, truth, &options, |f| {
@@ -164,12 +167,12 @@ pub fn run(command: Command) -> Result<(), String> {
             if show {
                 eprintln!();
             }
-            print_problems(&result.problems, &result.report);
+            print_problems(&result, config.filter.coupling);
             println!(
                 "{} solutions, {} GNSS updates",
                 result.report.solutions, result.report.epochs
             );
-            if let Some(s) = result.summary {
+            if let Some(s) = result.summary() {
                 println!(
                     "position RMSE E {:.3} N {:.3} U {:.3} 3D {:.3} m; velocity {:.4} m/s; \
                      attitude roll {:.4} pitch {:.4} yaw {:.4} deg; mean NEES {:.2} ({} epochs)",
@@ -203,6 +206,15 @@ pub fn run(command: Command) -> Result<(), String> {
                     }
                 ));
             }
+            let (dropped, read) = result.imu_dropped(simulate::IMU_TOPIC);
+            if 2 * dropped > read {
+                return Err(format!(
+                    "{}: {dropped} of the {read} IMU messages did not reach the filter (see \
+                     above): the {} solutions written cover only part of the bag",
+                    bag.display(),
+                    result.report.solutions
+                ));
+            }
             Ok(())
         }
         Command::Compare {
@@ -218,7 +230,8 @@ pub fn run(command: Command) -> Result<(), String> {
                 Some(p) => Some(load_config(Some(p))?),
                 None => None,
             };
-            let runs = compare_bag(&bag, &filters, params_dir.as_deref(), base.as_ref())?;
+            let configs = variant_configs(&filters, params_dir.as_deref(), base.as_ref())?;
+            let runs = compare_bag(&bag, &configs, TRUTH_TOPIC)?;
             let rows: Vec<ComparisonRow> = runs.iter().map(|(row, _)| row.clone()).collect();
             print!("{}", render(&rows, format)?);
             if by_environment {
@@ -263,7 +276,7 @@ pub fn run(command: Command) -> Result<(), String> {
                 bag.display(),
                 scenario.duration_s()
             );
-            let runs = compare_bag(&bag, &[], None, None)?;
+            let runs = compare_bag(&bag, &variant_configs(&[], None, None)?, TRUTH_TOPIC)?;
             let rows: Vec<ComparisonRow> = runs.into_iter().map(|(row, _)| row).collect();
             print!("{}", format_table(&rows));
             Ok(())
@@ -282,9 +295,18 @@ fn progress_bar(fraction: f64) -> String {
     )
 }
 
-fn print_problems(problems: &super::bag_inputs::ReadProblems, report: &SessionReport) {
+/// What the replay skipped and dropped, on stderr: the bag's problems, the adapter's
+/// drops (named as on the node's /diagnostics) and the engine's rejections.
+fn print_problems(run: &BagRun, coupling: Coupling) {
+    let problems = &run.problems;
     for (what, n) in &problems.unused_topics {
         eprintln!("ignored {n} messages on a topic this run does not use: {what}");
+    }
+    for (topic, n) in &problems.unfed_inputs {
+        eprintln!(
+            "ignored {n} messages on {topic}: not an input with filter.coupling {}",
+            coupling.as_str()
+        );
     }
     for (what, n) in &problems.wrong_types {
         eprintln!("skipped {n} messages of an unexpected type: {what}");
@@ -295,7 +317,7 @@ fn print_problems(problems: &super::bag_inputs::ReadProblems, report: &SessionRe
     for e in &problems.bag_errors {
         eprintln!("bag error: {e}");
     }
-    let v = &problems.velocities;
+    let v = run.velocities();
     if v.paired + v.unpaired + v.foreign_frame > 0 {
         eprintln!(
             "velocities: {} paired with their fix, {} without a fix of their stamp, {} in a \
@@ -303,14 +325,31 @@ fn print_problems(problems: &super::bag_inputs::ReadProblems, report: &SessionRe
             v.paired, v.unpaired, v.foreign_frame
         );
     }
-    if !report.rejected.is_empty() {
-        let mut by_reason = std::collections::BTreeMap::new();
-        for r in &report.rejected {
-            *by_reason.entry(r.reason.name()).or_insert(0u64) += 1;
-        }
-        for (reason, n) in by_reason {
-            eprintln!("rejected {n} inputs: {reason}");
-        }
+    // Undecodable messages are listed above with their reasons; velocities just now.
+    let drops = run.counts.named().into_iter().filter(|(name, n)| {
+        *n > 0
+            && (name.starts_with("unconvertible")
+                || name.starts_with("foreign_frame_") && *name != "foreign_frame_velocity")
+    });
+    for (name, n) in drops {
+        eprintln!("dropped {n} messages: {name}");
+    }
+    if run.counts.non_finite_outputs > 0 {
+        eprintln!(
+            "warning: {} solutions with a non-finite value were not written \
+             (non_finite_outputs)",
+            run.counts.non_finite_outputs
+        );
+    }
+    if run.counts.time_jump_resets > 0 {
+        eprintln!(
+            "warning: the IMU time jumped back more than {} s {} times; the filter was reset \
+             and started again each time (time_jump_resets)",
+            TIME_JUMP_BACK_S, run.counts.time_jump_resets
+        );
+    }
+    for (reason, n) in run.rejections.iter() {
+        eprintln!("rejected {n} inputs: {}", reason.name());
     }
 }
 
@@ -360,13 +399,12 @@ fn variant_config(
     Ok(config)
 }
 
-/// Runs each filter over the bag and returns one row and the session report per filter.
-fn compare_bag(
-    bag: &Path,
+/// The named configurations of `filters` (all variants when empty).
+fn variant_configs(
     filters: &[String],
     params_dir: Option<&Path>,
     base: Option<&Config>,
-) -> Result<Vec<(ComparisonRow, SessionReport)>, String> {
+) -> Result<Vec<NamedConfig>, String> {
     let names: Vec<String> = if filters.is_empty() {
         FilterVariant::ALL
             .iter()
@@ -375,22 +413,13 @@ fn compare_bag(
     } else {
         filters.to_vec()
     };
-    let mut rows = Vec::new();
-    for name in names {
-        let config = variant_config(&name, params_dir, base)?;
-        let inputs =
-            replay::bag_inputs(bag, Some(TRUTH_TOPIC.to_owned())).map_err(|e| e.to_string())?;
-        let start = Instant::now();
-        let mut session = Session::new(config, SCORE_INTERVAL_S, None);
-        for input in inputs {
-            session.push(input);
-        }
-        let runtime = start.elapsed().as_secs_f64();
-        let report = session.finish();
-        let row = ComparisonRow::new(&name, &report.summary(f64::NEG_INFINITY), runtime);
-        rows.push((row, report));
-    }
-    Ok(rows)
+    names
+        .into_iter()
+        .map(|name| {
+            let config = variant_config(&name, params_dir, base)?;
+            Ok(NamedConfig { name, config })
+        })
+        .collect()
 }
 
 fn render(rows: &[ComparisonRow], format: Format) -> Result<String, String> {

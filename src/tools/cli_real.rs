@@ -11,10 +11,9 @@ use super::convert::{
     ImuTime, TruthInput,
 };
 use super::imu_csv::{AccelUnit, GyroUnit, ImuCsvFormat};
-use super::replay::bag_inputs;
 use super::simulate::TRUTH_TOPIC;
 use super::spp_rinex::spp_rinex as solve_rinex_files;
-use super::spp_run::{run_spp_with, write_spp_csv};
+use super::spp_run::{bag_spp_inputs, run_spp_with, write_spp_csv};
 use super::time_scale::DEFAULT_GPS_UTC_LEAP_S;
 use crate::gnss::atmosphere::TroposphereModel;
 use crate::gnss::ionosphere::IonosphereMode;
@@ -312,7 +311,7 @@ pub fn spp(args: SppArgs) -> Result<(), String> {
     } else {
         args.input.clone()
     };
-    let inputs = bag_inputs(&bag, Some(TRUTH_TOPIC.to_owned())).map_err(|e| e.to_string());
+    let inputs = bag_spp_inputs(&bag, Some(TRUTH_TOPIC.to_owned())).map_err(|e| e.to_string());
     let per_constellation = args.clock == ClockArg::PerConstellation;
     let report = inputs.map(|inputs| run_spp_with(inputs, &config, per_constellation));
     if is_ubx {

@@ -27,7 +27,7 @@ use super::param_docs;
 use super::params::{
     OutputFrames, BASE_FRAME, DEFAULT_QUEUE_DEPTH, MAP_FRAME, PUBLISH_TF, QUEUE_DEPTH, USE_SIM_TIME,
 };
-use super::NodeCore;
+use crate::ros::adapter::RosAdapter;
 
 /// `ListParameters` depth meaning "no limit".
 const DEPTH_RECURSIVE: u64 = 0;
@@ -374,7 +374,7 @@ impl ParameterServer {
         }
     }
 
-    fn set_one(&mut self, core: &mut NodeCore, param: &Parameter) -> Result<(), String> {
+    fn set_one(&mut self, core: &mut RosAdapter, param: &Parameter) -> Result<(), String> {
         if param.name == USE_SIM_TIME {
             self.use_sim_time = Self::sim_time_value(param)?;
             return Ok(());
@@ -384,7 +384,7 @@ impl ParameterServer {
     }
 
     /// `set_parameters`: each parameter on its own, one result each.
-    pub fn set(&mut self, core: &mut NodeCore, params: &[Parameter]) -> SetParametersResponse {
+    pub fn set(&mut self, core: &mut RosAdapter, params: &[Parameter]) -> SetParametersResponse {
         let results = params
             .iter()
             .map(|p| {
@@ -399,7 +399,7 @@ impl ParameterServer {
     /// `set_parameters_atomically`: all or none.
     pub fn set_atomically(
         &mut self,
-        core: &mut NodeCore,
+        core: &mut RosAdapter,
         params: &[Parameter],
     ) -> SetParametersAtomicallyResponse {
         let mut config = core.engine().config().clone();
@@ -542,7 +542,7 @@ mod tests {
     #[test]
     fn set_applies_runtime_parameters_and_refuses_the_rest_with_a_reason() {
         let mut s = ParameterServer::new(false, OutputFrames::default());
-        let mut core = NodeCore::new(Config::default(), OutputFrames::default());
+        let mut core = RosAdapter::new(Config::default(), OutputFrames::default());
         let r = s.set(
             &mut core,
             &[
@@ -598,7 +598,7 @@ mod tests {
     #[test]
     fn set_atomically_is_all_or_nothing() {
         let mut s = ParameterServer::new(false, OutputFrames::default());
-        let mut core = NodeCore::new(Config::default(), OutputFrames::default());
+        let mut core = RosAdapter::new(Config::default(), OutputFrames::default());
         let r = s.set_atomically(
             &mut core,
             &[
@@ -628,7 +628,7 @@ mod tests {
             publish_tf: true,
         };
         let mut s = ParameterServer::new(false, frames);
-        let mut core = NodeCore::new(Config::default(), OutputFrames::default());
+        let mut core = RosAdapter::new(Config::default(), OutputFrames::default());
         let c = Config::default();
         let n = names(&["map_frame", "base_frame", "publish_tf"]);
         let v = s.get(&c, &n).values;

@@ -2,6 +2,7 @@
 //! loader) and the `-p` overrides.
 
 use crate::config::{Config, ConfigError};
+pub use crate::ros::adapter::OutputFrames;
 use crate::ros::args::{params_key_matches, NodeArgs};
 
 /// Why the node's configuration could not be built.
@@ -61,30 +62,6 @@ pub const NODE_PARAMETERS: [&str; 5] =
 pub const DEFAULT_QUEUE_DEPTH: usize = 200;
 /// Largest accepted [`QUEUE_DEPTH`] (a minute of a 1 kHz IMU).
 pub const MAX_QUEUE_DEPTH: usize = 60_000;
-
-/// The frames of the node's outputs and whether it publishes them on `/tf`.
-///
-/// Choice: fixed at start (read-only through the parameter services): a TF tree whose
-/// frames change while it runs would break its listeners.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct OutputFrames {
-    /// Parent frame of Odometry and TF (default `map`).
-    pub map_frame: String,
-    /// Child frame of Odometry and TF, frame of NavSatFix (default `base_link`).
-    pub base_frame: String,
-    /// Publish the TF `map_frame` → `base_frame` (default false).
-    pub publish_tf: bool,
-}
-
-impl Default for OutputFrames {
-    fn default() -> Self {
-        Self {
-            map_frame: "map".to_owned(),
-            base_frame: "base_link".to_owned(),
-            publish_tf: false,
-        }
-    }
-}
 
 /// What the command line configures: the core's configuration and the node's own
 /// parameters.
