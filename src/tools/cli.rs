@@ -341,6 +341,13 @@ fn print_problems(run: &BagRun, coupling: Coupling) {
             run.counts.non_finite_outputs
         );
     }
+    if run.counts.negative_variance_outputs > 0 {
+        eprintln!(
+            "warning: {} solutions with a negative variance were not written \
+             (negative_variance_outputs)",
+            run.counts.negative_variance_outputs
+        );
+    }
     if run.counts.time_jump_resets > 0 {
         eprintln!(
             "warning: the IMU time jumped back more than {} s {} times; the filter was reset \

@@ -53,6 +53,8 @@ pub struct InputCounts {
     pub time_jump_resets: u64,
     /// Outputs not published because a value was not finite.
     pub non_finite_outputs: u64,
+    /// Outputs not published because a covariance had a negative variance.
+    pub negative_variance_outputs: u64,
     /// IMU messages from another frame than the first accepted one (a second publisher).
     pub foreign_frame_imu: u64,
     /// GnssMeasurements messages from another frame than the first accepted one.
@@ -86,7 +88,7 @@ impl InputCounts {
 
     /// The counters as (name, value) in the order of the /diagnostics report; the names
     /// are the report's keys.
-    pub fn named(&self) -> [(&'static str, u64); 16] {
+    pub fn named(&self) -> [(&'static str, u64); 17] {
         [
             ("imu_received", self.imu_received),
             ("gnss_received", self.gnss_received),
@@ -100,6 +102,7 @@ impl InputCounts {
             ("unconvertible_velocity", self.unconvertible_velocity),
             ("time_jump_resets", self.time_jump_resets),
             ("non_finite_outputs", self.non_finite_outputs),
+            ("negative_variance_outputs", self.negative_variance_outputs),
             ("foreign_frame_imu", self.foreign_frame_imu),
             ("foreign_frame_gnss", self.foreign_frame_gnss),
             ("foreign_frame_fix", self.foreign_frame_fix),

@@ -62,6 +62,15 @@ pub struct PublishedSolution {
     pub tf: Option<TFMessage>,
 }
 
+/// Why a solution was not published.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Unpublishable {
+    /// A value, or its time, is not finite.
+    NonFinite,
+    /// A covariance has a negative variance on its diagonal (the filter diverged).
+    NegativeVariance,
+}
+
 /// The output frames and the datum of the Odometry.
 #[derive(Debug, Clone)]
 pub(super) struct Framing {
@@ -79,18 +88,28 @@ impl Framing {
         &self.frames
     }
 
-    /// The messages of `solution`; None when its time has no ROS stamp or a value is not
-    /// finite.
-    fn solution(&mut self, solution: Box<Solution>) -> Option<PublishedSolution> {
-        let stamp = seconds_to_time(solution.nav.t_s).ok()?;
+    /// The messages of `solution`, unless its time has no ROS stamp or a value is not
+    /// finite, or a variance is negative.
+    ///
+    /// Choice: a negative variance is as unusable as a NaN (its σ is not a number, and
+    /// a consumer inverting the covariance would be misled), so such a solution is
+    /// dropped and counted too; only the diagonals are checked, which costs nothing.
+    fn solution(&mut self, solution: Box<Solution>) -> Result<PublishedSolution, Unpublishable> {
+        let stamp = seconds_to_time(solution.nav.t_s).map_err(|_| Unpublishable::NonFinite)?;
         let datum = *self.datum.get_or_insert(solution.nav.p);
         let f = &self.frames;
         let odometry = outbound::odometry(&solution, &datum, stamp, &f.map_frame, &f.base_frame);
         let fix = outbound::nav_sat_fix(&solution, stamp, &f.base_frame);
         if !(odometry_is_finite(&odometry) && fix_is_finite(&fix)) {
-            return None;
+            return Err(Unpublishable::NonFinite);
         }
-        Some(PublishedSolution {
+        let (pose, twist) = (&odometry.pose.covariance, &odometry.twist.covariance);
+        let negative = (0..6).any(|k| pose[7 * k] < 0.0 || twist[7 * k] < 0.0)
+            || (0..3).any(|k| fix.position_covariance[4 * k] < 0.0);
+        if negative {
+            return Err(Unpublishable::NegativeVariance);
+        }
+        Ok(PublishedSolution {
             tf: f.publish_tf.then(|| outbound::transform(&odometry)),
             solution,
             odometry: Box::new(odometry),
@@ -107,12 +126,19 @@ impl RosAdapter {
         for output in outputs {
             match output {
                 Output::Solution(solution) => match self.outputs.solution(solution) {
-                    Some(s) => published.push(Published::Solution(s)),
-                    None => {
+                    Ok(s) => published.push(Published::Solution(s)),
+                    Err(Unpublishable::NonFinite) => {
                         self.counts.non_finite_outputs += 1;
                         self.log.warn(
                             "non_finite_output",
                             "solution with a non-finite value dropped",
+                        );
+                    }
+                    Err(Unpublishable::NegativeVariance) => {
+                        self.counts.negative_variance_outputs += 1;
+                        self.log.warn(
+                            "negative_variance_output",
+                            "solution with a negative variance dropped",
                         );
                     }
                 },
