@@ -398,7 +398,7 @@ mod tests {
     use proptest::prelude::*;
 
     use super::*;
-    use crate::ros::msg::{Header, Point, SatelliteMeasurement};
+    use crate::ros::msg::{Header, NavSatStatus, Point, SatelliteMeasurement};
 
     /// `(m, e)` with `v = m * 2^e` exactly, for a normal positive `v`.
     fn decompose(v: f64) -> (i128, i32) {
@@ -762,6 +762,45 @@ mod tests {
                 field: "twist.linear",
                 ..
             })
+        ));
+    }
+
+    #[test]
+    fn receiver_fix_from_a_nav_sat_fix_with_a_solution() {
+        let mut msg = NavSatFix::default();
+        msg.header.stamp = Time {
+            sec: 12,
+            nanosec: 500_000_000,
+        };
+        (msg.latitude, msg.longitude, msg.altitude) = (39.1, 117.2, 10.0);
+        msg.position_covariance = [4.0, 0.5, 0.0, 0.5, 9.0, 0.0, 0.0, 0.0, 16.0];
+        msg.position_covariance_type = NavSatFix::COVARIANCE_TYPE_KNOWN;
+        let fix = GnssFix::try_from(&msg).unwrap();
+        assert_eq!(fix.t_s, 12.5);
+        assert_eq!(fix.position, Llh::from_degrees(39.1, 117.2, 10.0));
+        let c = fix.position_covariance_enu_m2.unwrap();
+        assert_eq!(
+            (c[(0, 0)], c[(0, 1)], c[(1, 0)], c[(2, 2)]),
+            (4.0, 0.5, 0.5, 16.0)
+        );
+        assert_eq!(fix.velocity_enu_mps, None, "the velocity joins later");
+        msg.position_covariance_type = NavSatFix::COVARIANCE_TYPE_UNKNOWN;
+        assert_eq!(
+            GnssFix::try_from(&msg).unwrap().position_covariance_enu_m2,
+            None
+        );
+        msg.status.status = NavSatStatus::STATUS_NO_FIX;
+        assert_eq!(
+            GnssFix::try_from(&msg),
+            Err(ConvertError::NoFix {
+                t_s: 12.5,
+                status: -1
+            })
+        );
+        msg.header.stamp.nanosec = 1_000_000_000;
+        assert!(matches!(
+            GnssFix::try_from(&msg),
+            Err(ConvertError::InvalidStamp { .. })
         ));
     }
 }
