@@ -216,6 +216,7 @@ fn a_corrupt_chunk_is_skipped_and_the_rest_is_replayed() {
     // Small chunks so that one corrupt chunk is a small part of the bag.
     let small_chunks = BagWriteOptions {
         chunk_size_bytes: 64 * 1024,
+        ..BagWriteOptions::default()
     };
     let bag = dir.path().join("chunks.mcap");
     copy_fixture(&bag, small_chunks, |_| {}, |_, _| Copy::Keep);

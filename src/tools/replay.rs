@@ -10,7 +10,7 @@ use crate::config::Config;
 use crate::earth::Llh;
 use crate::eval::{TruthSample, TruthTrack};
 use crate::ros::adapter::{OutputFrames, Published};
-use crate::ros::bag::{BagError, BagReader, BagWriter};
+use crate::ros::bag::{BagError, BagReader, BagWriteOptions, BagWriter, ChunkCompression};
 use crate::ros::msg::{Imu, NavSatFix, NoiseEstimates, Odometry, RosMessage, TFMessage, Time};
 
 use super::bag_inputs::BagTopics;
@@ -71,6 +71,8 @@ pub struct ReplayOptions<'a> {
     /// The frames of the written messages (the node's `map_frame`, `base_frame`,
     /// `publish_tf`).
     pub frames: OutputFrames,
+    /// Compression of the output bag's chunks.
+    pub compression: ChunkCompression,
 }
 
 /// Replays `bag` with `config`; `progress` is called now and then with the fraction of
@@ -144,7 +146,11 @@ impl ReplayOutputs {
     fn create(options: &ReplayOptions) -> Result<Self, ReplayError> {
         let bag = match options.out_bag {
             Some(p) => {
-                let mut w = BagWriter::create(p)?;
+                let bag_options = BagWriteOptions {
+                    compression: options.compression,
+                    ..BagWriteOptions::default()
+                };
+                let mut w = BagWriter::create_with_options(p, bag_options)?;
                 if options.frames.publish_tf {
                     w.add_topic::<TFMessage>(TF_TOPIC)?;
                 }

@@ -23,4 +23,4 @@ pub use definition::{full_definition, short_type_name, MissingDefinition};
 pub use error::BagError;
 pub use qos::{Durability, OfferedQos, Reliability};
 pub use reader::{BagMessage, BagMessages, BagReader, ReadOrder, TopicInfo};
-pub use writer::{BagWriteOptions, BagWriter};
+pub use writer::{BagWriteOptions, BagWriter, ChunkCompression};
