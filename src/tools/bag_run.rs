@@ -8,7 +8,7 @@ use std::path::Path;
 
 use crate::config::{Config, Coupling};
 use crate::engine::{RejectionCounters, RejectionReason};
-use crate::eval::{ErrorSummary, TruthTrack};
+use crate::eval::ErrorSummary;
 use crate::ros::adapter::{Input, InputCounts, OutputFrames, Published, RosAdapter};
 use crate::ros::bag::{BagError, BagReader};
 
@@ -93,8 +93,7 @@ impl BagRun {
     }
 }
 
-/// A run of `config` over the bag `path` publishing in `frames`, the reference on
-/// `truth_topic` or `track`.
+/// A run of an adapter over a bag, scored by a scorer.
 pub struct BagRunner {
     inputs: BagInputs,
     adapter: RosAdapter,
@@ -104,28 +103,26 @@ pub struct BagRunner {
 }
 
 impl BagRunner {
-    /// Opens `path` for a run of `config`; `topics.truth` streams the reference unless a
-    /// `track` is given.
+    /// A run of `adapter` over the messages of `reader` on `topics`, scored by `scorer`
+    /// (the reference on `topics.truth`, or the scorer's own track).
     pub fn open(
         reader: &BagReader,
         topics: BagTopics,
-        config: &Config,
-        frames: OutputFrames,
-        score_interval_s: f64,
-        track: Option<TruthTrack>,
+        adapter: RosAdapter,
+        scorer: Scorer,
     ) -> Result<Self, BagError> {
-        let fed = fed_inputs(config.filter.coupling);
+        let fed = fed_inputs(adapter.engine().config().filter.coupling);
         Ok(Self {
             inputs: BagInputs::new(reader.messages()?, topics, fed),
-            adapter: RosAdapter::new(config.clone(), frames),
-            scorer: Scorer::new(score_interval_s, track),
+            adapter,
+            scorer,
             total_messages: reader.topics().iter().map(|t| t.message_count).sum(),
         })
     }
 
-    /// Opens the bag at `path` for a run of `config` scored against `truth_topic`, in the
-    /// node's default frames.
-    pub fn open_path(
+    /// A run of `config` over the bag at `path` that publishes nothing, scored against
+    /// `truth_topic` at most every `score_interval_s` (0: every match).
+    pub fn scoring_only(
         path: &Path,
         config: &Config,
         truth_topic: Option<String>,
@@ -136,13 +133,12 @@ impl BagRunner {
             truth: truth_topic,
             ..BagTopics::default()
         };
+        let adapter = RosAdapter::new(config.clone(), OutputFrames::default()).without_messages();
         Self::open(
             &reader,
             topics,
-            config,
-            OutputFrames::default(),
-            score_interval_s,
-            None,
+            adapter,
+            Scorer::new(score_interval_s, None),
         )
     }
 

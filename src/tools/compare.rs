@@ -81,7 +81,7 @@ fn run_one(
 ) -> RunResult {
     let start = Instant::now();
     let error = |e: &dyn std::fmt::Display| format!("{}: {e}", named.name);
-    let runner = BagRunner::open_path(
+    let runner = BagRunner::scoring_only(
         bag,
         &named.config,
         Some(truth_topic.to_owned()),

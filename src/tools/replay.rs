@@ -9,12 +9,13 @@ use std::path::Path;
 use crate::config::Config;
 use crate::earth::Llh;
 use crate::eval::{TruthSample, TruthTrack};
-use crate::ros::adapter::{OutputFrames, Published};
+use crate::ros::adapter::{OutputFrames, Published, RosAdapter};
 use crate::ros::bag::{BagError, BagReader, BagWriteOptions, BagWriter, ChunkCompression};
 use crate::ros::msg::{Imu, NavSatFix, NoiseEstimates, Odometry, RosMessage, TFMessage, Time};
 
 use super::bag_inputs::BagTopics;
 use super::bag_run::{BagRun, BagRunner};
+use super::scoring::Scorer;
 
 /// Output topics of a replay.
 pub const ODOMETRY_TOPIC: &str = "/odometry";
@@ -122,15 +123,14 @@ pub fn replay(
         });
     }
     let mut out = ReplayOutputs::create(options)?;
-    let frames = options.frames.clone();
-    let runner = BagRunner::open(
-        &reader,
-        topics,
-        config,
-        frames,
-        options.score_interval_s,
-        track,
-    )?;
+    let adapter = RosAdapter::new(config.clone(), options.frames.clone());
+    let adapter = if options.out_bag.is_some() {
+        adapter
+    } else {
+        adapter.without_messages()
+    };
+    let scorer = Scorer::new(options.score_interval_s, track);
+    let runner = BagRunner::open(&reader, topics, adapter, scorer)?;
     let run = runner.run(|published| out.write(published), progress)?;
     out.finish()?;
     Ok(run)
@@ -183,14 +183,18 @@ impl ReplayOutputs {
         if let Some(w) = self.bag.as_mut() {
             match published {
                 Published::Solution(s) => {
-                    let ns = log_time_ns(&s.odometry.header.stamp);
-                    if let Some(tf) = &s.tf {
-                        w.write(TF_TOPIC, tf, ns)?;
+                    // A replay with an output bag frames every solution.
+                    if let Some(m) = &s.messages {
+                        let ns = log_time_ns(&m.odometry.header.stamp);
+                        if let Some(tf) = &m.tf {
+                            w.write(TF_TOPIC, tf, ns)?;
+                        }
+                        w.write(ODOMETRY_TOPIC, &m.odometry, ns)?;
+                        w.write(FIX_OUT_TOPIC, &m.fix, ns)?;
                     }
-                    w.write(ODOMETRY_TOPIC, &*s.odometry, ns)?;
-                    w.write(FIX_OUT_TOPIC, &s.fix, ns)?;
                 }
-                Published::Epoch { noise, .. } => {
+                Published::Epoch(epoch) => {
+                    let noise = &epoch.noise;
                     w.write(NOISE_TOPIC, noise, log_time_ns(&noise.header.stamp))?;
                 }
             }

@@ -145,7 +145,7 @@ impl Scorer {
     pub fn on_published(&mut self, published: Published) {
         match published {
             Published::Solution(s) => self.on_solution(s.solution),
-            Published::Epoch { report, .. } => self.on_epoch(&report),
+            Published::Epoch(epoch) => self.on_epoch(&epoch.report),
         }
     }
 

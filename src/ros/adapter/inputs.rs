@@ -87,7 +87,11 @@ impl RosAdapter {
         match self.engine.push_imu(&sample) {
             Ok(o) => {
                 self.imu_frame.accepted(&msg.header.frame_id);
-                outputs.extend(o);
+                if outputs.is_empty() {
+                    outputs = o;
+                } else {
+                    outputs.extend(o);
+                }
             }
             Err(e) => {
                 self.log.warn(e.reason.name(), &format!("imu: {e}"));

@@ -28,7 +28,7 @@ use ros2_client::{
 };
 
 use crate::ros::adapter::log_limit::LogLimiter;
-use crate::ros::adapter::{Published, PublishedSolution, RosAdapter};
+use crate::ros::adapter::{Published, PublishedSolution, RosAdapter, SolutionMessages};
 use crate::ros::args::NodeArgs;
 use crate::ros::msg::{
     Clock, DiagnosticArray, GnssMeasurements, Imu, Log, NavSatFix, NoiseEstimates, Odometry,
@@ -219,17 +219,18 @@ impl Outputs {
             let recorder = &mut self.recorder;
             let log = &mut self.log;
             match p {
-                Published::Solution(PublishedSolution {
-                    odometry, fix, tf, ..
-                }) => {
+                Published::Solution(PublishedSolution { messages, .. }) => {
+                    // The node's adapter frames every solution.
+                    let Some(m) = messages else { continue };
+                    let SolutionMessages { odometry, fix, tf } = *m;
                     if let (Some(t), Some(out)) = (tf, &self.tf) {
                         log_failure(log, out.send(t, recorder, now));
                     }
-                    log_failure(log, self.odometry.send(*odometry, recorder, now));
+                    log_failure(log, self.odometry.send(odometry, recorder, now));
                     log_failure(log, self.fix.send(fix, recorder, now));
                 }
-                Published::Epoch { noise, .. } => {
-                    log_failure(log, self.noise.send(noise, recorder, now));
+                Published::Epoch(epoch) => {
+                    log_failure(log, self.noise.send(epoch.noise, recorder, now));
                 }
             }
         }
