@@ -48,6 +48,18 @@ fn stderr(output: &Output) -> String {
     String::from_utf8_lossy(&output.stderr).into_owned()
 }
 
+/// Runs `gnss_ins replay BAG --csv CSV`; returns its output and its stderr.
+fn replay_to_csv(bag: &Path, csv: &Path) -> (Output, String) {
+    let output = gnss_ins(&[
+        "replay".as_ref(),
+        bag.as_os_str(),
+        "--csv".as_ref(),
+        csv.as_os_str(),
+    ]);
+    let text = stderr(&output);
+    (output, text)
+}
+
 /// Adds `topic` to `writer` with the type `type_name` (one of the fixture's types).
 fn add_topic(writer: &mut BagWriter, topic: &str, type_name: &str) {
     match type_name {
@@ -402,13 +414,7 @@ fn one_imu_sample_stamped_far_ahead_costs_a_reset_not_the_rest_of_the_bag() {
     );
 
     let csv = dir.path().join("ahead.csv");
-    let output = gnss_ins(&[
-        "replay".as_ref(),
-        bag.as_os_str(),
-        "--csv".as_ref(),
-        csv.as_os_str(),
-    ]);
-    let text = stderr(&output);
+    let (output, text) = replay_to_csv(&bag, &csv);
     assert!(output.status.success(), "{text}");
     assert!(text.contains("time_jump_resets"), "{text}");
     let last_t_s = csv_rows(&csv).last().unwrap()[0];
@@ -432,13 +438,7 @@ fn a_replay_that_drops_most_imu_samples_fails_and_keeps_its_outputs() {
     assert_eq!(result.imu_dropped("/imu"), (2100, 3601));
 
     let csv = dir.path().join("frozen.csv");
-    let output = gnss_ins(&[
-        "replay".as_ref(),
-        bag.as_os_str(),
-        "--csv".as_ref(),
-        csv.as_os_str(),
-    ]);
-    let text = stderr(&output);
+    let (output, text) = replay_to_csv(&bag, &csv);
     assert!(!output.status.success(), "{text}");
     assert!(
         text.contains("2100 of the 3601 IMU messages did not reach the filter"),
@@ -505,13 +505,7 @@ fn solutions_with_a_non_finite_value_or_a_negative_variance_are_counted_and_not_
         "the bag must provoke bad solutions: {non_finite}, {negative}"
     );
 
-    let output = gnss_ins(&[
-        "replay".as_ref(),
-        bag.as_os_str(),
-        "--csv".as_ref(),
-        dir.path().join("spikes_cli.csv").as_os_str(),
-    ]);
-    let text = stderr(&output);
+    let (output, text) = replay_to_csv(&bag, &dir.path().join("spikes_cli.csv"));
     assert!(output.status.success(), "{text}");
     assert!(
         text.contains("solutions with a negative variance were not written"),

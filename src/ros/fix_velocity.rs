@@ -1,7 +1,6 @@
-//! `gnss/fix` joined with the `gnss/velocity` of its stamp: the
-//! [`FixPairing`](super::fix_pairing::FixPairing) over the converted messages, plus the
-//! rule which velocity frames are usable. The adapter joins through [`FixVelocityJoin`]
-//! for the live node and `gnss_ins replay` alike.
+//! `gnss/fix` joined with the `gnss/velocity` of its stamp: the [`FixPairing`] over the
+//! converted messages, plus the rule which velocity frames are usable. The adapter joins
+//! through [`FixVelocityJoin`] for the live node and `gnss_ins replay` alike.
 
 use crate::engine::GnssFix;
 use crate::ros::convert::GnssVelocity;

@@ -1,7 +1,7 @@
 //! Decoded input messages into the engine: conversion, frame locks, the time-jump rule and
 //! the fix / velocity join; what is dropped is counted and logged (rate-limited).
 
-use crate::engine::{Output, ResetReason};
+use crate::engine::{GnssFix, Output, ResetReason};
 use crate::gnss::GnssEpoch;
 use crate::ins::ImuSample;
 use crate::ros::convert::GnssVelocity;
@@ -23,18 +23,6 @@ pub enum InputMessage {
     Gnss(GnssMeasurements),
     Fix(NavSatFix),
     Velocity(TwistWithCovarianceStamped),
-}
-
-impl InputMessage {
-    /// The stream the message belongs to.
-    pub fn input(&self) -> Input {
-        match self {
-            InputMessage::Imu(_) => Input::Imu,
-            InputMessage::Gnss(_) => Input::Gnss,
-            InputMessage::Fix(_) => Input::Fix,
-            InputMessage::Velocity(_) => Input::Velocity,
-        }
-    }
 }
 
 impl RosAdapter {
@@ -127,7 +115,7 @@ impl RosAdapter {
     /// dropped.
     pub fn on_fix(&mut self, msg: &NavSatFix) -> Vec<Published> {
         self.counts.fix_received += 1;
-        let fix = match crate::engine::GnssFix::try_from(msg) {
+        let fix = match GnssFix::try_from(msg) {
             Ok(f) => f,
             Err(e) => return self.unconvertible(Input::Fix, &e.to_string()),
         };
@@ -138,9 +126,7 @@ impl RosAdapter {
             fix,
             frame_id: msg.header.frame_id.clone(),
         });
-        let mut outputs = Vec::new();
-        self.push_fixes(released, &mut outputs);
-        self.publishable(outputs)
+        self.publish_fixes(released)
     }
 
     /// Handles one velocity on `gnss/velocity` (loose coupling): it joins the fix of its
@@ -154,8 +140,13 @@ impl RosAdapter {
             Err(e) => return self.unconvertible(Input::Velocity, &e.to_string()),
         };
         let released = self.pairing.on_velocity(velocity);
+        self.publish_fixes(released)
+    }
+
+    /// Feeds joined fixes; what the engine returned, to publish.
+    fn publish_fixes(&mut self, joined: Vec<Joined>) -> Vec<Published> {
         let mut outputs = Vec::new();
-        self.push_fixes(released, &mut outputs);
+        self.push_fixes(joined, &mut outputs);
         self.publishable(outputs)
     }
 

@@ -8,8 +8,9 @@
 //! [`ImuSample::try_from`](crate::ins::ImuSample), frame lock, time-jump rule, the fixes
 //! the join releases at this IMU time) → [`Engine::push_imu`] (mechanization and
 //! covariance propagation, a [`Solution`](crate::engine::Solution) per sample or at
-//! `output.rate_hz`) → [`outputs`] (finiteness check, Odometry, NavSatFix and, with
-//! `publish_tf`, the TF) → [`Published::Solution`].
+//! `output.rate_hz`) → `outputs` (the guard: every number finite, no negative variance;
+//! then Odometry, NavSatFix and, with `publish_tf`, the TF) → [`Published::Solution`],
+//! which keeps the solution for `replay`'s CSV and scoring.
 //!
 //! Data flow of one GNSS epoch: `GnssMeasurements` → [`RosAdapter::on_gnss`] (conversion
 //! [`GnssEpoch::try_from`](crate::gnss::GnssEpoch), frame lock) → [`Engine::push_gnss`]
@@ -19,12 +20,13 @@
 //! velocity join for the `gnss/velocity` of its stamp, then goes to [`Engine::push_fix`].
 //!
 //! Adding an input message: its conversion in [`crate::ros::convert`], one handler method
-//! in [`inputs`] (and its [`InputMessage`] variant and [`Input`] counters); then the
+//! in `inputs.rs` (and its [`InputMessage`] variant and [`Input`] counters); then the
 //! node's subscription and the bag topic of `gnss_ins replay`.
 
 mod counts;
 mod diagnostics;
 mod frame_lock;
+mod guard;
 mod inputs;
 pub mod log_limit;
 mod outputs;
