@@ -15,10 +15,13 @@ use crate::ros::bag::{BagError, BagReader};
 use super::bag_inputs::{BagInput, BagInputs, BagTopics, ReadProblems};
 use super::scoring::{Scorer, SessionReport};
 
-/// The input streams a run feeds: the IMU and the measurements of the configured coupling
-/// (the node receives the others too, and its engine rejects them as `wrong_coupling`
-/// without any other effect; a run counts them as unfed instead of logging each).
-pub fn fed_inputs(coupling: Coupling) -> &'static [Input] {
+/// The input streams a run feeds: the IMU and the measurements of the configured coupling.
+///
+/// Choice: the node receives the other coupling's measurements too, and its engine
+/// rejects each as `wrong_coupling` without any other effect; a bag carries both (the
+/// simulator writes both), so a run counts them once as unfed instead of logging a
+/// rejection for each.
+fn fed_inputs(coupling: Coupling) -> &'static [Input] {
     match coupling {
         Coupling::Tight => &[Input::Imu, Input::Gnss],
         Coupling::Loose => &[Input::Imu, Input::Fix, Input::Velocity],

@@ -44,6 +44,11 @@ pub fn compare_bag(
         .min(configs.len());
     let next = AtomicUsize::new(0);
     let progress = Progress::new(configs);
+    eprintln!(
+        "compare: {} configurations over {} on {workers} threads",
+        configs.len(),
+        bag.display()
+    );
     let results: Mutex<Vec<Option<RunResult>>> = Mutex::new(vec![None; configs.len()]);
     std::thread::scope(|scope| {
         for _ in 0..workers {

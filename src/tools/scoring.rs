@@ -1,8 +1,9 @@
 //! Scoring of a run's solutions against a reference: a preloaded track (a CSV) or
 //! reference samples streamed with the inputs (a bag's `/ground_truth`), the estimated
-//! noise σ against the true one, by environment. It sees only what was published (the
-//! adapter's solutions and epoch reports), so `replay`, `compare` and the tests' sessions
-//! score alike.
+//! noise σ against the true one, by environment. `replay` and `compare` feed it what the
+//! adapter published (so nothing the node would not publish is scored); a
+//! [`Session`](super::session::Session) over a simulated scenario feeds it the engine's
+//! outputs.
 
 use std::collections::{BTreeMap, HashMap};
 

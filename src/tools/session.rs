@@ -4,6 +4,7 @@
 
 use crate::config::{Config, Coupling};
 use crate::engine::{Engine, GnssFix, Output};
+use crate::eval::TruthTrack;
 use crate::gnss::GnssEpoch;
 use crate::ins::ImuSample;
 
@@ -27,11 +28,7 @@ pub struct Session {
 impl Session {
     /// A session running `config`, scoring at most every `score_interval_s` (0: every
     /// match), against `track` when given, else against the streamed references.
-    pub fn new(
-        config: Config,
-        score_interval_s: f64,
-        track: Option<crate::eval::TruthTrack>,
-    ) -> Self {
+    pub fn new(config: Config, score_interval_s: f64, track: Option<TruthTrack>) -> Self {
         Self {
             engine: Engine::new(config),
             scorer: Scorer::new(score_interval_s, track),

@@ -86,6 +86,21 @@ impl InputCounts {
         }
     }
 
+    /// The messages dropped before the engine that decoded: (name, count) of the ones that
+    /// did not convert and the ones from a foreign frame (a velocity in a foreign frame
+    /// drops no message: its fix goes on alone), named as on /diagnostics.
+    pub fn dropped(&self) -> [(&'static str, u64); 7] {
+        [
+            ("unconvertible_imu", self.unconvertible_imu),
+            ("unconvertible_gnss", self.unconvertible_gnss),
+            ("unconvertible_fix", self.unconvertible_fix),
+            ("unconvertible_velocity", self.unconvertible_velocity),
+            ("foreign_frame_imu", self.foreign_frame_imu),
+            ("foreign_frame_gnss", self.foreign_frame_gnss),
+            ("foreign_frame_fix", self.foreign_frame_fix),
+        ]
+    }
+
     /// The counters as (name, value) in the order of the /diagnostics report; the names
     /// are the report's keys.
     pub fn named(&self) -> [(&'static str, u64); 17] {
