@@ -14,7 +14,10 @@
 //!
 //! ## Layers
 //! The core (`earth`, `ins`, `gnss`, `filter`, `engine`, `config`) does no I/O, reads no
-//! clock and knows nothing of ROS; `ros` converts messages and wires the node.
+//! clock and knows nothing of ROS; `ros` converts messages, holds the adapter that turns
+//! decoded messages into engine inputs and engine outputs into messages (for the node and
+//! `gnss_ins replay` alike), and wires the node; `tools` are the offline tools, the only
+//! code that reads and writes files besides the node's recorder.
 
 pub mod adaptive;
 pub mod config;
