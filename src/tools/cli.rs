@@ -72,12 +72,12 @@ pub enum Command {
         /// Comma-separated variants (e.g. ekf,ermakf); all when absent.
         #[arg(long, value_delimiter = ',')]
         filters: Vec<String>,
-        /// Folder of parameter files named <variant>.yaml, each loaded after the --params
+        /// Folder of parameter files named VARIANT.yaml, each loaded after the --params
         /// files for its variant (e.g. --params-dir params: the presets).
         #[arg(long)]
         params_dir: Option<PathBuf>,
         /// Parameter file (e.g. a sensor description) for every variant, its
-        /// filter.variant replaced by each variant in turn (unless its <variant>.yaml of
+        /// filter.variant replaced by each variant in turn (unless its VARIANT.yaml of
         /// --params-dir sets it); repeatable, a later value wins.
         #[arg(long)]
         params: Vec<PathBuf>,

@@ -5,7 +5,7 @@
 //! The parameters are the core configuration's (`section.key`, human units, the names of
 //! the parameter file) plus the node's own `use_sim_time`, `map_frame`, `base_frame`,
 //! `publish_tf` and `queue_depth`; their descriptions, ranges and read-only flags come
-//! from the parameter table and [`NODE_PARAMETERS`]. A set request is validated like the
+//! from the parameter table and `NODE_PARAMETERS`. A set request is validated like the
 //! parameter file; only the run-time parameters (and `use_sim_time`) are accepted while
 //! the node runs, every other parameter is read-only and a set is refused with the reason.
 //!
