@@ -237,6 +237,7 @@ pub struct ConvertArgs {
 impl ConvertArgs {
     /// The conversion these arguments ask for.
     pub fn options(&self) -> Result<ConvertOptions, String> {
+        self.check_numbers()?;
         let imu = match &self.imu_csv {
             None => None,
             Some(csv) => {
@@ -304,6 +305,39 @@ impl ConvertArgs {
             },
             ionosphere: self.ionosphere.mode(),
         })
+    }
+}
+
+impl ConvertArgs {
+    /// Every numeric argument within its range (NaN never is).
+    ///
+    /// Choice of ranges: mounting angles within ±360°; geoid separations within ±120 m
+    /// (the EGM2008 undulation spans −107…+86 m); GPS − UTC a whole number of seconds in
+    /// 0..=100 (18 since 2017); a receiver-to-host latency up to 10 s.
+    fn check_numbers(&self) -> Result<(), String> {
+        for angle in &self.imu_to_flu_rpy_deg {
+            within("imu-to-flu-rpy-deg", *angle, -360.0, 360.0)?;
+        }
+        let r = &self.reference;
+        within("geoid-separation-m", r.geoid_separation_m, -120.0, 120.0)?;
+        within("leap-seconds", r.leap_seconds, 0.0, 100.0)?;
+        if r.leap_seconds.fract() != 0.0 {
+            return Err(format!(
+                "--leap-seconds must be a whole number, got {}",
+                r.leap_seconds
+            ));
+        }
+        within("host-latency-s", self.robot_bag.host_latency_s, 0.0, 10.0)?;
+        Ok(())
+    }
+}
+
+/// An error naming argument `--name` unless `value` lies in [lo, hi].
+fn within(name: &str, value: f64, lo: f64, hi: f64) -> Result<(), String> {
+    if (lo..=hi).contains(&value) {
+        Ok(())
+    } else {
+        Err(format!("--{name} must lie in [{lo}, {hi}], got {value}"))
     }
 }
 
@@ -510,4 +544,42 @@ pub fn spp_rinex(args: SppRinexArgs) -> Result<(), String> {
         s.skipped_records
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::Parser;
+
+    use super::ConvertArgs;
+
+    #[derive(Parser)]
+    struct Convert {
+        #[command(flatten)]
+        args: ConvertArgs,
+    }
+
+    fn options_of(extra: &[&str]) -> Result<(), String> {
+        let mut argv = vec!["convert", "--ubx", "log.ubx", "--out", "out.mcap"];
+        argv.extend_from_slice(extra);
+        let parsed = Convert::try_parse_from(argv).map_err(|e| e.to_string())?;
+        parsed.args.options().map(|_| ())
+    }
+
+    #[test]
+    fn numeric_arguments_out_of_range_are_refused() {
+        assert_eq!(options_of(&[]), Ok(()));
+        assert_eq!(options_of(&["--imu-to-flu-rpy-deg", "180,-90,45"]), Ok(()));
+        for bad in [
+            ["--imu-to-flu-rpy-deg", "nan,0,0"],
+            ["--imu-to-flu-rpy-deg", "0,1e300,0"],
+            ["--geoid-separation-m", "nan"],
+            ["--geoid-separation-m", "-1e9"],
+            ["--leap-seconds", "inf"],
+            ["--leap-seconds", "18.5"],
+            ["--host-latency-s", "11"],
+        ] {
+            let err = options_of(&bad).expect_err(&bad.join(" "));
+            assert!(err.contains(bad[0]), "{}: {err}", bad.join(" "));
+        }
+    }
 }
