@@ -7,9 +7,10 @@
 //! Needs the venv made by `scripts/setup_test_peers.sh` (CI runs it first).
 
 mod bag_support;
+mod venv_support;
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 use adaptive_gnss_ins::ros::bag::{BagWriteOptions, Durability, OfferedQos, Reliability};
@@ -21,18 +22,6 @@ use adaptive_gnss_ins::ros::msg::{
 use bag_support::{fix, gnss, header, imu, noise, odometry, stamp, Recorder, START_NS};
 use serde::Serialize;
 use serde_json::{json, Value};
-
-/// The Python interpreter of the test-peer venv.
-fn venv_python() -> PathBuf {
-    let python = Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv/bin/python");
-    assert!(
-        python.exists(),
-        "{} is missing: run scripts/setup_test_peers.sh first (it creates the venv with \
-         the pinned rosbags package)",
-        python.display()
-    );
-    python
-}
 
 /// What one topic of the bag must look like in the rosbags summary.
 struct ExpectedTopic {
@@ -175,7 +164,7 @@ fn write_bag(path: &Path) -> BTreeMap<String, ExpectedTopic> {
 /// Runs tools/check_bag_with_rosbags.py on `bag` and parses its JSON summary.
 fn rosbags_summary(bag: &Path) -> Value {
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/check_bag_with_rosbags.py");
-    let output = Command::new(venv_python())
+    let output = Command::new(venv_support::python())
         .arg(&script)
         .arg(bag)
         .output()

@@ -14,6 +14,8 @@ use adaptive_gnss_ins::ros::node::params::{
     config_from_files, load, NodeParams, NODE_PARAMETERS, USE_SIM_TIME,
 };
 
+mod venv_support;
+
 /// The names of the node's own parameters.
 fn node_parameter_names() -> Vec<&'static str> {
     NODE_PARAMETERS.iter().map(|p| p.name).collect()
@@ -36,11 +38,11 @@ fn stdout_or_stderr(out: &std::process::Output) -> Result<String, String> {
 fn python_launch_file_parses_and_names_existing_things() {
     let launch = root().join("launch_scripts/gnss_ins_node.launch.py");
     let text = std::fs::read_to_string(&launch).unwrap();
-    let out = Command::new("python3")
+    let out = Command::new(venv_support::python())
         .args(["-c", "import ast, sys; ast.parse(open(sys.argv[1]).read())"])
         .arg(&launch)
         .output()
-        .expect("python3 is needed to check the launch file");
+        .expect("the venv python runs the launch file harness");
     assert!(
         out.status.success(),
         "{}",
@@ -193,14 +195,14 @@ else:
 /// Runs the harness in `mode` with `args`, from the package root (where `ros2 launch`
 /// is run in the README), and returns its standard output.
 fn harness(mode: &str, args: &[String]) -> Result<String, String> {
-    let out = Command::new("python3")
+    let out = Command::new(venv_support::python())
         .current_dir(root())
         .arg("-c")
         .arg(HARNESS)
         .arg(mode)
         .args(args)
         .output()
-        .expect("python3 is needed to check the launch file");
+        .expect("the venv python runs the launch file harness");
     stdout_or_stderr(&out)
 }
 

@@ -10,8 +10,9 @@
 //! network namespace with only loopback.
 
 mod netns_support;
+mod venv_support;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Stdio};
 
 use serde_json::Value;
@@ -25,18 +26,6 @@ const SPEED_UP: &str = "4";
 
 fn manifest_dir() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// The Python interpreter of the test-peer venv; fails (does not skip) without it.
-fn venv_python() -> PathBuf {
-    let python = manifest_dir().join(".venv/bin/python");
-    assert!(
-        python.exists(),
-        "FAILED, not skipped: {} is missing. Run `bash scripts/setup_test_peers.sh` first \
-         (it creates the venv with the pinned cyclonedds and rosbags packages).",
-        python.display()
-    );
-    python
 }
 
 /// The datum of the fixture's truth, from the scenario the bag was simulated from.
@@ -109,7 +98,7 @@ fn run_peer(python: &Path, script: &str, namespace: &str, extra_args: &[&str]) -
 /// that every solution equals `gnss_ins replay`'s (tests/data/fixture_small_solution.csv).
 #[test]
 fn cyclonedds_peer_sets_parameters_and_plays_a_bag_into_the_node() {
-    let python = venv_python();
+    let python = venv_support::python();
     if reexec_in_private_netns("cyclonedds_peer_sets_parameters_and_plays_a_bag_into_the_node") {
         return;
     }
@@ -133,7 +122,7 @@ fn cyclonedds_peer_sets_parameters_and_plays_a_bag_into_the_node() {
 /// the node keeps running and publishes no NaN (tools/cyclonedds_bad_inputs.py).
 #[test]
 fn cyclonedds_peer_bad_inputs_are_counted_and_the_node_carries_on() {
-    let python = venv_python();
+    let python = venv_support::python();
     if reexec_in_private_netns("cyclonedds_peer_bad_inputs_are_counted_and_the_node_carries_on") {
         return;
     }

@@ -15,8 +15,9 @@
 //! network namespace with only loopback.
 
 mod netns_support;
+mod venv_support;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Stdio};
 
 use serde_json::Value;
@@ -31,18 +32,6 @@ const RMW: &str = "rmw_fastrtps_cpp";
 
 fn manifest_dir() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// The Python interpreter of the test-peer venv; fails (does not skip) without it.
-fn venv_python() -> PathBuf {
-    let python = manifest_dir().join(".venv/bin/python");
-    assert!(
-        python.exists(),
-        "FAILED, not skipped: {} is missing. Run `bash scripts/setup_test_peers.sh` first \
-         (it creates the venv with the pinned ROS 2 Jazzy rclpy and Fast DDS wheels).",
-        python.display()
-    );
-    python
 }
 
 fn start_node(args: &[&str]) -> KillOnDrop {
@@ -98,7 +87,7 @@ fn gnss_ins(args: &[&str]) {
 /// and the node's /diagnostics and /rosout stamped with the /clock times it sent.
 #[test]
 fn jazzy_rclpy_plays_a_bag_and_receives_the_replay_solution() {
-    let python = venv_python();
+    let python = venv_support::python();
     if reexec_in_private_netns("jazzy_rclpy_plays_a_bag_and_receives_the_replay_solution") {
         return;
     }
@@ -145,7 +134,7 @@ fn jazzy_rclpy_plays_a_bag_and_receives_the_replay_solution() {
 /// range, wrong type) and an all-or-nothing atomic set.
 #[test]
 fn jazzy_parameter_client_lists_describes_and_sets_parameters() {
-    let python = venv_python();
+    let python = venv_support::python();
     if reexec_in_private_netns("jazzy_parameter_client_lists_describes_and_sets_parameters") {
         return;
     }
@@ -163,7 +152,7 @@ fn jazzy_parameter_client_lists_describes_and_sets_parameters() {
 /// them); the mismatch and the latency are printed.
 #[test]
 fn jazzy_imu_at_200_hz_gets_one_output_per_sample_at_its_stamp() {
-    let python = venv_python();
+    let python = venv_support::python();
     if reexec_in_private_netns("jazzy_imu_at_200_hz_gets_one_output_per_sample_at_its_stamp") {
         return;
     }

@@ -27,6 +27,8 @@ use adaptive_gnss_ins::tools::replay::{replay, ReplayOptions, TruthSource};
 use adaptive_gnss_ins::tools::simulate::simulate;
 use serde_json::Value;
 
+mod venv_support;
+
 /// Relative tolerance of the comparison (see the module doc).
 const RELATIVE_TOLERANCE: f64 = 1e-9;
 /// Seed of the fixture's simulation.
@@ -67,21 +69,10 @@ fn replay_fixture(out: &Path) -> usize {
     result.report.solutions
 }
 
-/// The Python interpreter of the test-peer venv.
-fn venv_python() -> PathBuf {
-    let python = Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv/bin/python");
-    assert!(
-        python.exists(),
-        "{} is missing: run scripts/setup_test_peers.sh first",
-        python.display()
-    );
-    python
-}
-
 #[test]
 fn rosbags_reads_the_fixture_as_a_ros2_bag() {
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/check_bag_with_rosbags.py");
-    let output = Command::new(venv_python())
+    let output = Command::new(venv_support::python())
         .arg(&script)
         .arg(fixture_bag())
         .output()
