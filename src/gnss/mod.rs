@@ -13,4 +13,4 @@ pub mod rinex_spp;
 pub mod spp;
 pub mod ubx;
 
-pub use observation::{Constellation, GnssEpoch, Klobuchar, SatId, SatObservation};
+pub use observation::{CarrierPhase, Constellation, GnssEpoch, Klobuchar, SatId, SatObservation};
