@@ -25,7 +25,8 @@
 use adaptive_gnss_ins::config::{Config, FilterVariant};
 use adaptive_gnss_ins::sim::Scenario;
 use adaptive_gnss_ins::tools::scenario_inputs::scenario_inputs;
-use adaptive_gnss_ins::tools::session::{Session, SessionReport};
+use adaptive_gnss_ins::tools::scoring::SessionReport;
+use adaptive_gnss_ins::tools::session::Session;
 
 /// The scenario's seed (fixed: the comparison is one realization, as the paper's).
 const SEED: u64 = 1;

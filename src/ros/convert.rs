@@ -6,7 +6,11 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::msg::{GnssMeasurements, Imu, SatelliteMeasurement, Time, TwistWithCovarianceStamped};
+use super::msg::{
+    GnssMeasurements, Imu, NavSatFix, SatelliteMeasurement, Time, TwistWithCovarianceStamped,
+};
+use crate::earth::Llh;
+use crate::engine::GnssFix;
 use crate::gnss::{CarrierPhase, Constellation, GnssEpoch, Klobuchar, SatId, SatObservation};
 use crate::ins::ImuSample;
 
@@ -84,6 +88,43 @@ pub enum ConvertError {
         /// Name of the field in `geometry_msgs/TwistWithCovariance`.
         field: &'static str,
     },
+    /// A NavSatFix whose status says the receiver has no solution.
+    #[error("NavSatFix at {t_s} s: status {status}, no solution")]
+    NoFix {
+        /// Stamp of the fix (s).
+        t_s: f64,
+        /// `status.status` (below `STATUS_FIX`, 0).
+        status: i8,
+    },
+}
+
+/// A receiver fix from a NavSatFix with a solution (`status.status` ≥ 0). The position
+/// covariance is taken as ENU (REP-145 and sensor_msgs); with `COVARIANCE_TYPE_UNKNOWN`
+/// there is none and the configured σ applies. The velocity joins later (see
+/// [`crate::ros::fix_velocity`]). Non-finite values pass: the engine rejects and counts
+/// them.
+impl TryFrom<&NavSatFix> for GnssFix {
+    type Error = ConvertError;
+
+    fn try_from(msg: &NavSatFix) -> Result<Self, Self::Error> {
+        let t_s = time_to_seconds(&msg.header.stamp)?;
+        if msg.status.status < 0 {
+            return Err(ConvertError::NoFix {
+                t_s,
+                status: msg.status.status,
+            });
+        }
+        let c = &msg.position_covariance;
+        let covariance = (msg.position_covariance_type != NavSatFix::COVARIANCE_TYPE_UNKNOWN)
+            .then(|| Matrix3::from_fn(|r, k| c[3 * r + k]));
+        Ok(GnssFix {
+            t_s,
+            position: Llh::from_degrees(msg.latitude, msg.longitude, msg.altitude),
+            position_covariance_enu_m2: covariance,
+            velocity_enu_mps: None,
+            velocity_covariance_enu_m2_s2: None,
+        })
+    }
 }
 
 /// A receiver's velocity (`gnss/velocity`), waiting to join the fix of its stamp.
@@ -389,7 +430,7 @@ mod tests {
     use proptest::prelude::*;
 
     use super::*;
-    use crate::ros::msg::{Header, Point, SatelliteMeasurement};
+    use crate::ros::msg::{Header, NavSatStatus, Point, SatelliteMeasurement};
 
     /// `(m, e)` with `v = m * 2^e` exactly, for a normal positive `v`.
     fn decompose(v: f64) -> (i128, i32) {
@@ -815,6 +856,45 @@ mod tests {
                 field: "twist.linear",
                 ..
             })
+        ));
+    }
+
+    #[test]
+    fn receiver_fix_from_a_nav_sat_fix_with_a_solution() {
+        let mut msg = NavSatFix::default();
+        msg.header.stamp = Time {
+            sec: 12,
+            nanosec: 500_000_000,
+        };
+        (msg.latitude, msg.longitude, msg.altitude) = (39.1, 117.2, 10.0);
+        msg.position_covariance = [4.0, 0.5, 0.0, 0.5, 9.0, 0.0, 0.0, 0.0, 16.0];
+        msg.position_covariance_type = NavSatFix::COVARIANCE_TYPE_KNOWN;
+        let fix = GnssFix::try_from(&msg).unwrap();
+        assert_eq!(fix.t_s, 12.5);
+        assert_eq!(fix.position, Llh::from_degrees(39.1, 117.2, 10.0));
+        let c = fix.position_covariance_enu_m2.unwrap();
+        assert_eq!(
+            (c[(0, 0)], c[(0, 1)], c[(1, 0)], c[(2, 2)]),
+            (4.0, 0.5, 0.5, 16.0)
+        );
+        assert_eq!(fix.velocity_enu_mps, None, "the velocity joins later");
+        msg.position_covariance_type = NavSatFix::COVARIANCE_TYPE_UNKNOWN;
+        assert_eq!(
+            GnssFix::try_from(&msg).unwrap().position_covariance_enu_m2,
+            None
+        );
+        msg.status.status = NavSatStatus::STATUS_NO_FIX;
+        assert_eq!(
+            GnssFix::try_from(&msg),
+            Err(ConvertError::NoFix {
+                t_s: 12.5,
+                status: -1
+            })
+        );
+        msg.header.stamp.nanosec = 1_000_000_000;
+        assert!(matches!(
+            GnssFix::try_from(&msg),
+            Err(ConvertError::InvalidStamp { .. })
         ));
     }
 }

@@ -186,7 +186,7 @@ pub fn noise_estimates(report: &EpochReport, stamp: Time, frame_id: &str) -> Noi
     }
 }
 
-/// sensor_msgs/Imu of a sample (REP-145; orientation unknown: covariance[0] = −1).
+/// sensor_msgs/Imu of a sample (REP-145; orientation unknown: `covariance[0] = −1`).
 pub fn imu(sample: &crate::ins::ImuSample, stamp: Time, frame_id: &str) -> Imu {
     let mut orientation_covariance = [0.0; 9];
     orientation_covariance[0] = -1.0;

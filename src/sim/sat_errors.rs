@@ -191,7 +191,7 @@ impl SatErrorGenerator {
     ///
     /// The σ reported is the root-mean-square of the added error over the environment's
     /// random draws, given the satellite's NLOS bias (which is fixed for the segment):
-    /// σ² = σ_th² (1 − p + p s²) + σ_mp² + p_out E[M²] + β², E[M²] = (a² + ab + b²)/3 for
+    /// σ² = σ_th² (1 − p + p s²) + σ_mp² + p_out E\[M²\] + β², E\[M²\] = (a² + ab + b²)/3 for
     /// M ~ U[a, b], and for the rate σ_th,rate² (1 − p + p s²) + σ_mp,rate².
     pub fn draw(&mut self, ctx: &SatContext<'_>) -> Option<SatErrorTruth> {
         self.begin_epoch(ctx.epoch_index);

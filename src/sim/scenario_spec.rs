@@ -7,7 +7,7 @@ use crate::gnss::Klobuchar;
 use crate::sim::ar_process::ArModel;
 use crate::sim::environment::{Environment, EnvironmentSegment};
 use crate::sim::receiver_clock::ReceiverClockSpec;
-use crate::sim::scenario::ScenarioError;
+use crate::sim::scenario_error::ScenarioError;
 use crate::sim::{ImuErrorSpec, TrajectorySpec};
 
 /// Highest IMU rate accepted (Hz).

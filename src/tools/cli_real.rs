@@ -5,7 +5,6 @@ use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
 
-use super::cli::load_config;
 use super::convert::{
     convert as convert_files, ConvertOptions, ConvertSummary, EphemerisMode, GnssSource, ImuInput,
     ImuTime, TruthInput,
@@ -15,14 +14,14 @@ use super::convert_bag::{
     DEFAULT_SFRBX_TOPIC, DEFAULT_STREAM_TOPIC,
 };
 use super::imu_csv::{AccelUnit, GyroUnit, ImuCsvFormat};
-use super::replay::bag_inputs;
 use super::simulate::TRUTH_TOPIC;
 use super::spp_rinex::spp_rinex as solve_rinex_files;
-use super::spp_run::{run_spp_with, write_spp_csv};
-use super::time_scale::DEFAULT_GPS_UTC_LEAP_S;
+use super::spp_run::{bag_spp_inputs, run_spp_with, write_spp_csv};
 use crate::gnss::atmosphere::TroposphereModel;
 use crate::gnss::ionosphere::IonosphereMode;
 use crate::gnss::rinex_spp::{Ionosphere, RinexSppOptions};
+use crate::gnss::time_scale::DEFAULT_GPS_UTC_LEAP_S;
+use crate::ros::node::params::config_from_files;
 use crate::ros::ubx_adapter::{TimeBase, DEFAULT_HOST_LATENCY_S};
 
 /// Unit of the accelerometer columns.
@@ -416,7 +415,7 @@ pub fn convert(args: ConvertArgs) -> Result<(), String> {
 
 /// `gnss_ins spp`.
 pub fn spp(args: SppArgs) -> Result<(), String> {
-    let config = load_config(&args.params)?;
+    let config = config_from_files(&args.params).map_err(|e| e.to_string())?;
     let is_ubx = args
         .input
         .extension()
@@ -444,7 +443,7 @@ pub fn spp(args: SppArgs) -> Result<(), String> {
     } else {
         args.input.clone()
     };
-    let inputs = bag_inputs(&bag, Some(TRUTH_TOPIC.to_owned())).map_err(|e| e.to_string());
+    let inputs = bag_spp_inputs(&bag, Some(TRUTH_TOPIC.to_owned())).map_err(|e| e.to_string());
     let per_constellation = args.clock == ClockArg::PerConstellation;
     let report = inputs.map(|inputs| run_spp_with(inputs, &config, per_constellation));
     if is_ubx {

@@ -15,7 +15,8 @@ use ros2_client::{
 };
 
 use super::param_server::ParameterServer;
-use super::{dds_error, NodeCore, NodeError};
+use super::{dds_error, NodeError};
+use crate::ros::adapter::RosAdapter;
 
 /// The request/reply mapping of the ROS 2 middleware named by `RMW_IMPLEMENTATION`.
 ///
@@ -138,7 +139,12 @@ impl ParameterServices {
     }
 
     /// Answers `request` (setting parameters on `core` and `params`).
-    pub fn answer(&self, request: ParamRequest, params: &mut ParameterServer, core: &mut NodeCore) {
+    pub fn answer(
+        &self,
+        request: ParamRequest,
+        params: &mut ParameterServer,
+        core: &mut RosAdapter,
+    ) {
         let config = core.engine().config().clone();
         match request {
             ParamRequest::List(id, r) => sent(
