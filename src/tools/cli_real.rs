@@ -500,13 +500,18 @@ pub fn spp(args: SppArgs) -> Result<(), String> {
         println!("  inter-system bias of {c:?} against the first clock: {bias_m:.3} m mean over {n} epochs");
     }
     println!(
-        "{:<14} {:>7} {:>8} {:>8} {:>8}",
-        "reference", "epochs", "horiz_m", "vert_m", "pos3d_m"
+        "{:<14} {:>7} {:>8} {:>12} {:>8} {:>8}",
+        "reference", "epochs", "horiz_m", "horiz_demean", "vert_m", "pos3d_m"
     );
     for (label, s) in report.summary_by_label() {
         println!(
-            "{:<14} {:>7} {:>8.3} {:>8.3} {:>8.3}",
-            label, s.epochs, s.pos_rmse_horizontal_m, s.pos_rmse_u_m, s.pos_rmse_3d_m
+            "{:<14} {:>7} {:>8.3} {:>12.3} {:>8.3} {:>8.3}",
+            label,
+            s.epochs,
+            s.pos_rmse_horizontal_m,
+            s.pos_rmse_horizontal_offset_removed_m,
+            s.pos_rmse_u_m,
+            s.pos_rmse_3d_m
         );
     }
     Ok(())
