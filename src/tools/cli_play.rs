@@ -10,6 +10,7 @@ use crate::ros::player::{self, PlayOptions};
 
 #[derive(Args)]
 pub struct PlayArgs {
+    /// The bag to play: an .mcap file or a rosbag2 directory holding one.
     bag: PathBuf,
     /// Speed factor (2 plays twice as fast as recorded), 0.001 to 1000.
     #[arg(long, default_value_t = 1.0)]

@@ -207,8 +207,10 @@ pub struct ConvertArgs {
     /// stamped with --imu-tag; gpst_s: GPST seconds since 1970), '-' to ignore a column.
     #[arg(long, default_value = "ax,ay,az,gx,gy,gz,tick_ms")]
     pub imu_columns: String,
+    /// Unit of the accelerometer columns.
     #[arg(long, value_enum, default_value_t = AccelUnitArg::G)]
     pub imu_accel_unit: AccelUnitArg,
+    /// Unit of the gyro columns.
     #[arg(long, value_enum, default_value_t = GyroUnitArg::DegPerS)]
     pub imu_gyro_unit: GyroUnitArg,
     /// Rotation taking IMU-axis vectors into the FLU body frame: roll,pitch,yaw in degrees,
@@ -225,8 +227,10 @@ pub struct ConvertArgs {
     pub robot_bag: RobotBagArgs,
     #[command(flatten)]
     pub reference: ReferenceArgs,
+    /// Which ephemerides each epoch may use.
     #[arg(long, value_enum, default_value_t = EphemerisArg::WholeLog)]
     pub ephemeris: EphemerisArg,
+    /// The pseudo-ranges to form.
     #[arg(long, value_enum, default_value_t = IonosphereArg::IonoFree)]
     pub ionosphere: IonosphereArg,
     /// Output bag.
