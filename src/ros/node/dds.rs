@@ -32,6 +32,8 @@ pub enum NodeError {
     TopicName(String),
     #[error("{0}")]
     Record(String),
+    #[error("{0}")]
+    Parameter(String),
 }
 
 /// The DDS domain of `ROS_DOMAIN_ID` (unset or empty: 0).
@@ -153,7 +155,12 @@ impl<M: RosMessage + std::fmt::Debug> Output<M> {
     }
 
     /// Publishes `message`, recording it first when a recording is open.
-    pub fn send(&self, message: M, recorder: &mut Option<Recorder>, now: Time) -> Result<(), String> {
+    pub fn send(
+        &self,
+        message: M,
+        recorder: &mut Option<Recorder>,
+        now: Time,
+    ) -> Result<(), String> {
         if let Some(r) = recorder.as_mut() {
             r.record(&self.topic, &message, now);
         }
@@ -163,13 +170,12 @@ impl<M: RosMessage + std::fmt::Debug> Output<M> {
     }
 }
 
-
 /// The participant on `dds`'s domain and the node named by `args`. ros2-client's own
 /// rosout, parameter services and sim time stay off: the nodes serve their parameters
 /// themselves and their /clock has the wrong type.
 pub fn create_node(args: &NodeArgs, dds: DdsOptions) -> Result<Node, NodeError> {
-    let context = Context::with_options(ContextOptions::new().domain_id(dds.domain_id))
-        .map_err(dds_error)?;
+    let context =
+        Context::with_options(ContextOptions::new().domain_id(dds.domain_id)).map_err(dds_error)?;
     let node_name = NodeName::new(&args.namespace, &args.node_name).map_err(dds_error)?;
     context
         .new_node(

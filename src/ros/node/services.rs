@@ -143,9 +143,10 @@ impl ParameterServices {
     /// Answers `request` with `handler`.
     pub fn answer(&self, request: ParamRequest, handler: &mut impl ParameterHandler) {
         match request {
-            ParamRequest::List(id, r) => {
-                sent("list_parameters", self.list.send_response(id, handler.list(&r)))
-            }
+            ParamRequest::List(id, r) => sent(
+                "list_parameters",
+                self.list.send_response(id, handler.list(&r)),
+            ),
             ParamRequest::Get(id, r) => sent(
                 "get_parameters",
                 self.get.send_response(id, handler.get(&r.names)),
