@@ -508,3 +508,32 @@ fn wait_for(sub: &Subscription<GnssMeasurements>, want: &GnssMeasurements) -> Gn
         std::thread::sleep(Duration::from_micros(200));
     }
 }
+
+#[test]
+fn ubx_node_help_prints_its_usage() {
+    let out = Command::new(env!("CARGO_BIN_EXE_gnss_ins_ubx_node"))
+        .arg("--help")
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.starts_with("Usage: gnss_ins_ubx_node"), "{stdout}");
+}
+
+/// The filter's parameters are no parameters of the adapter node: refused before any DDS
+/// participant is made, naming the parameter and where it came from.
+#[test]
+fn ubx_node_refuses_a_parameter_it_does_not_have() {
+    let out = Command::new(env!("CARGO_BIN_EXE_gnss_ins_ubx_node"))
+        .args(["--ros-args", "-p", "filter.variant:=ekf"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains(
+            "gnss_ins_ubx_node: -p filter.variant:=ekf: `filter.variant` is no parameter"
+        ),
+        "{stderr}"
+    );
+}

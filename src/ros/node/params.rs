@@ -170,10 +170,11 @@ impl NodeParameter {
     }
 }
 
-/// `docs/parameters.md`: the core's parameters and the node's.
+/// `docs/parameters.md`: the core's parameters, the node's, and those of
+/// `gnss_ins_ubx_node`.
 pub fn reference() -> String {
     let rows: Vec<Row> = NODE_PARAMETERS.iter().map(NodeParameter::row).collect();
-    crate::config::manual::reference(&rows)
+    crate::config::manual::reference(&rows) + &crate::ros::ubx_node::params::reference_section()
 }
 
 /// The frames of the node's outputs and whether it publishes them on `/tf`.

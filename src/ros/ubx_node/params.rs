@@ -4,6 +4,7 @@
 
 use serde_yaml::Value;
 
+use crate::config::manual::{table, Row};
 use crate::config::{Assignment, ConfigError, Kind};
 use crate::gnss::ionosphere::IonosphereMode;
 use crate::ros::args::{is_valid_topic_name, NodeArgs};
@@ -142,6 +143,18 @@ pub const UBX_NODE_PARAMETERS: [NodeParameter; 14] = [
         doc: "GnssMeasurements output (gnss_ins_node's input).",
     },
 ];
+
+/// The section of `docs/parameters.md` on `gnss_ins_ubx_node`.
+pub fn reference_section() -> String {
+    let mut text = String::from(
+        "\n## `gnss_ins_ubx_node`\n\nThe parameters of the u-blox adapter node (declared in \
+         `src/ros/ubx_node/params.rs`); it has no others and refuses the filter's. Topic \
+         names resolve as any (namespace, then remappings).\n\n",
+    );
+    let rows: Vec<Row> = UBX_NODE_PARAMETERS.iter().map(NodeParameter::row).collect();
+    table(&mut text, &rows);
+    text
+}
 
 /// The node's topics, relative to its namespace unless absolute.
 #[derive(Debug, Clone, PartialEq, Eq)]
