@@ -491,14 +491,12 @@ fn first_sfrbx(driver: &[(u64, DriverMessage)]) -> UbxRxmSfrbx {
 fn wait_for(sub: &Subscription<GnssMeasurements>, want: &GnssMeasurements) -> GnssMeasurements {
     let deadline = Instant::now() + Duration::from_secs(5);
     loop {
-        while let Ok(Some((m, _))) = sub.take() {
-            if m.header.stamp == want.header.stamp {
-                return m;
-            }
-            panic!(
-                "the adapter node published an epoch at {:?} while {:?} was due",
-                m.header.stamp, want.header.stamp
+        if let Ok(Some((m, _))) = sub.take() {
+            assert_eq!(
+                m.header.stamp, want.header.stamp,
+                "the adapter node published another epoch than the one due"
             );
+            return m;
         }
         assert!(
             Instant::now() < deadline,

@@ -61,7 +61,7 @@ enum Event {
     Rawx(Result<UbxRxmRawx, String>),
     Sfrbx(Result<UbxRxmSfrbx, String>),
     Stream(Result<UInt8MultiArray, String>),
-    Imu(Result<Imu, String>),
+    Imu(Result<Box<Imu>, String>),
     Clock(Result<Clock, String>),
     Param(ParamRequest),
     LogLine(LogLine),
@@ -105,7 +105,7 @@ pub fn run(
         events(&rawx_sub, Event::Rawx),
         events(&sfrbx_sub, Event::Sfrbx),
         events(&stream_sub, Event::Stream),
-        events(&imu_sub, Event::Imu),
+        events(&imu_sub, |r| Event::Imu(r.map(Box::new))),
         events(&clock_sub, Event::Clock),
         dds::diagnostics_ticks(|| Event::Tick),
     ];
