@@ -18,6 +18,7 @@
 //! network namespace that has only loopback (`unshare -n`, needs root).
 
 mod netns_support;
+mod odometry_support;
 mod ubx_robot_support;
 
 use std::path::{Path, PathBuf};
@@ -25,7 +26,7 @@ use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 use adaptive_gnss_ins::gnss::ionosphere::IonosphereMode;
-use adaptive_gnss_ins::ros::bag::{BagReader, BagWriter};
+use adaptive_gnss_ins::ros::bag::BagWriter;
 use adaptive_gnss_ins::ros::cdr;
 use adaptive_gnss_ins::ros::msg::{
     DiagnosticArray, GnssMeasurements, Imu, Odometry, RosMessage, UbxRxmRawx, UbxRxmSfrbx,
@@ -33,17 +34,17 @@ use adaptive_gnss_ins::ros::msg::{
 use adaptive_gnss_ins::ros::node::params::config_from_files;
 use adaptive_gnss_ins::ros::ubx_adapter::{TimeBase, UbxAdapter, UbxAdapterParams};
 use adaptive_gnss_ins::tools::convert::{
-    convert, ConvertOptions, EphemerisMode, GnssSource, ImuInput, ImuTime, TruthInput,
+    convert, ConvertOptions, EphemerisMode, GnssSource, TruthInput,
 };
 use adaptive_gnss_ins::tools::convert_bag::{RobotBag, RobotBagTopics};
-use adaptive_gnss_ins::tools::imu_csv::{AccelUnit, GyroUnit, ImuCsvFormat};
 use adaptive_gnss_ins::tools::replay::{replay, ReplayOptions, TruthSource};
 use netns_support::{reexec_in_private_netns, KillOnDrop};
+use odometry_support::{decoded, largest_difference};
 use ros2_client::{
     Context, ContextOptions, MessageTypeName, Name, Node, NodeName, NodeOptions, Publisher,
     QosProfile, Subscription,
 };
-use ubx_robot_support::{driver_messages, walk_log, DriverMessage};
+use ubx_robot_support::{driver_messages, walk_imu_input, walk_log, walk_path, DriverMessage};
 
 const DOMAIN_ID: u16 = 31;
 const NAMESPACE: &str = "/vehicle";
@@ -57,12 +58,6 @@ const SETTLE: Duration = Duration::from_millis(5);
 /// Pause between IMU samples (about 6x real time at the walk's 166 Hz).
 const IMU_PAUSE: Duration = Duration::from_micros(1000);
 
-fn walk(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data/walk_0827")
-        .join(name)
-}
-
 fn params_files() -> [PathBuf; 2] {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     [
@@ -75,18 +70,8 @@ fn params_files() -> [PathBuf; 2] {
 fn walk_imu(dir: &Path) -> Vec<Imu> {
     let out = dir.join("walk.mcap");
     let options = ConvertOptions {
-        gnss: GnssSource::Ubx(walk("gnss_1730.ubx")),
-        imu: Some(ImuInput {
-            csv: walk("imu_1730.csv"),
-            format: ImuCsvFormat::new(
-                "ax,ay,az,gx,gy,gz,tick_ms",
-                AccelUnit::G,
-                GyroUnit::DegPerS,
-                [0.0, 0.0, 90.0],
-            )
-            .unwrap(),
-            time: ImuTime::Tag(walk("imu_1730.csv.tag")),
-        }),
+        gnss: GnssSource::Ubx(walk_path("gnss_1730.ubx")),
+        imu: Some(walk_imu_input([0.0, 0.0, 90.0])),
         truth: TruthInput::None,
         leap_seconds: 18.0,
         ephemeris: EphemerisMode::AsReceived,
@@ -94,17 +79,6 @@ fn walk_imu(dir: &Path) -> Vec<Imu> {
     };
     convert(&options, &out).unwrap();
     decoded(&out, "/imu")
-}
-
-fn decoded<M: RosMessage>(bag: &Path, topic: &str) -> Vec<M> {
-    BagReader::open(bag)
-        .unwrap()
-        .messages()
-        .unwrap()
-        .map(Result::unwrap)
-        .filter(|m| m.topic == topic)
-        .map(|m| cdr::decode::<M>(&m.data).unwrap())
-        .collect()
 }
 
 fn stamp_ns(m: &Imu) -> u64 {
@@ -201,27 +175,6 @@ fn diagnostic(d: &DiagnosticArray, node: &str, key: &str) -> Option<u64> {
         .flat_map(|s| &s.values)
         .find(|kv| kv.key == key)
         .and_then(|kv| kv.value.parse().ok())
-}
-
-/// Largest difference between two solutions' positions, velocities and orientations.
-fn largest_difference(a: &Odometry, b: &Odometry) -> f64 {
-    let (pa, pb) = (&a.pose.pose.position, &b.pose.pose.position);
-    let (va, vb) = (&a.twist.twist.linear, &b.twist.twist.linear);
-    let (qa, qb) = (&a.pose.pose.orientation, &b.pose.pose.orientation);
-    [
-        pa.x - pb.x,
-        pa.y - pb.y,
-        pa.z - pb.z,
-        va.x - vb.x,
-        va.y - vb.y,
-        va.z - vb.z,
-        qa.x - qb.x,
-        qa.y - qb.y,
-        qa.z - qb.z,
-        qa.w - qb.w,
-    ]
-    .iter()
-    .fold(0.0_f64, |m, d| m.max(d.abs()))
 }
 
 #[test]

@@ -132,18 +132,17 @@ pub fn run(
         events(&fix_sub, Event::Fix),
         events(&velocity_sub, Event::Velocity),
         events(&clock_sub, Event::Clock),
-        dds::diagnostics_ticks(|| Event::Tick),
     ];
-    sources.extend(
-        services
-            .streams()
-            .into_iter()
-            .map(|s| s.map(Event::Param).boxed_local()),
-    );
-    if let Some(lines) = log_lines {
-        sources.push(lines.map(Event::LogLine).boxed_local());
-    }
-    sources.extend(dds::stop_signals(|| Event::Shutdown));
+    sources.extend(dds::housekeeping(
+        &services,
+        log_lines,
+        dds::Housekeeping {
+            tick: || Event::Tick,
+            param: Event::Param,
+            log_line: Event::LogLine,
+            stop: || Event::Shutdown,
+        },
+    ));
     let mut events = stream::select_all(sources);
     log::info!(
         "{fqn} running filter variant {} on DDS domain {}{}",

@@ -107,18 +107,17 @@ pub fn run(
         events(&stream_sub, Event::Stream),
         events(&imu_sub, |r| Event::Imu(r.map(Box::new))),
         events(&clock_sub, Event::Clock),
-        dds::diagnostics_ticks(|| Event::Tick),
     ];
-    sources.extend(
-        services
-            .streams()
-            .into_iter()
-            .map(|s| s.map(Event::Param).boxed_local()),
-    );
-    if let Some(lines) = log_lines {
-        sources.push(lines.map(Event::LogLine).boxed_local());
-    }
-    sources.extend(dds::stop_signals(|| Event::Shutdown));
+    sources.extend(dds::housekeeping(
+        &services,
+        log_lines,
+        dds::Housekeeping {
+            tick: || Event::Tick,
+            param: Event::Param,
+            log_line: Event::LogLine,
+            stop: || Event::Shutdown,
+        },
+    ));
     let mut events = stream::select_all(sources);
     log::info!("{fqn} running on DDS domain {}", dds.domain_id);
 
