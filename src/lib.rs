@@ -13,8 +13,13 @@
 //! - SI units and radians everywhere inside; any other unit is in the name.
 //!
 //! ## Layers
-//! The core (`earth`, `ins`, `gnss`, `filter`, `engine`, `config`) does no I/O, reads no
-//! clock and knows nothing of ROS; `ros` converts messages and wires the node.
+//! The core (`earth`, `linalg`, `ins`, `gnss`, `filter`, `adaptive`, `engine`, `config`,
+//! `eval`, `sim`) does no I/O, reads no clock and knows nothing of ROS; `ros` converts
+//! messages, holds the adapter that turns decoded messages into engine inputs and engine
+//! outputs into messages (for the node and `gnss_ins replay` alike), the u-blox driver
+//! adapter, bags, and wires the node; `tools` are the offline tools, the only code that
+//! reads and writes files besides the node's recorder. The README's layout section and
+//! docs/architecture.md draw the same map.
 
 pub mod adaptive;
 pub mod config;

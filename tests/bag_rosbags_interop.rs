@@ -4,6 +4,8 @@
 //! (tools/check_bag_with_rosbags.py) must match what was written. The stored definitions
 //! are also checked against rosbags' ROS 2 Jazzy types and against msg/*.msg.
 //!
+//! The same bag is checked with uncompressed and with zstd-compressed chunks.
+//!
 //! Needs the venv made by `scripts/setup_test_peers.sh` (CI runs it first).
 
 mod bag_support;
@@ -13,7 +15,9 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::process::Command;
 
-use adaptive_gnss_ins::ros::bag::{BagWriteOptions, Durability, OfferedQos, Reliability};
+use adaptive_gnss_ins::ros::bag::{
+    BagWriteOptions, ChunkCompression, Durability, OfferedQos, Reliability,
+};
 use adaptive_gnss_ins::ros::msg::{
     Clock, DiagnosticArray, DiagnosticStatus, GnssMeasurements, Imu, KeyValue, NavSatFix,
     NoiseEstimates, Odometry, RosMessage, TFMessage, Transform, TransformStamped,
@@ -109,11 +113,12 @@ fn tf_static(t_ns: u64) -> TFMessage {
 }
 
 /// Writes a bag holding every message type of the crate.
-fn write_bag(path: &Path) -> BTreeMap<String, ExpectedTopic> {
+fn write_bag(path: &Path, compression: ChunkCompression) -> BTreeMap<String, ExpectedTopic> {
     let recorder = Recorder::create(
         path,
         BagWriteOptions {
             chunk_size_bytes: 8192,
+            compression,
         },
     );
     let mut bag = Bag {
@@ -181,10 +186,15 @@ fn rosbags_summary(bag: &Path) -> Value {
 #[test]
 fn rosbags_reads_every_message_with_the_definitions_stored_in_the_bag() {
     let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("interop.mcap");
-    let expected = write_bag(&path);
-    let summary = rosbags_summary(&path);
+    for compression in [ChunkCompression::None, ChunkCompression::Zstd] {
+        let path = dir.path().join(format!("interop_{compression:?}.mcap"));
+        let expected = write_bag(&path, compression);
+        check_summary(&rosbags_summary(&path), &expected);
+    }
+}
 
+/// The rosbags summary of a bag written by [`write_bag`] against what was written.
+fn check_summary(summary: &Value, expected: &BTreeMap<String, ExpectedTopic>) {
     assert_eq!(summary["reader"], "rosbags 0.11.9");
     let total: u64 = expected.values().map(|topic| topic.count).sum();
     assert_eq!(summary["message_count"], total);
@@ -199,7 +209,7 @@ fn rosbags_reads_every_message_with_the_definitions_stored_in_the_bag() {
         topics.keys().collect::<Vec<_>>(),
         expected.keys().collect::<Vec<_>>()
     );
-    for (name, want) in &expected {
+    for (name, want) in expected {
         let got = &topics[name];
         assert_eq!(got["type"], want.type_name, "{name}");
         assert_eq!(got["encoding"], "cdr", "{name}");

@@ -5,7 +5,8 @@ mod bag_support;
 use std::path::{Path, PathBuf};
 
 use adaptive_gnss_ins::ros::bag::{
-    BagError, BagMessage, BagReader, BagWriteOptions, BagWriter, ReadOrder, TopicInfo,
+    BagError, BagMessage, BagReader, BagWriteOptions, BagWriter, ChunkCompression, ReadOrder,
+    TopicInfo,
 };
 use adaptive_gnss_ins::ros::cdr;
 use adaptive_gnss_ins::ros::msg::{
@@ -20,6 +21,7 @@ use mcap::sans_io::{SummaryReadEvent, SummaryReader};
 /// Chunks this small put the 3 s sample bag (~130 kB) into dozens of chunks.
 const SMALL_CHUNKS: BagWriteOptions = BagWriteOptions {
     chunk_size_bytes: 4096,
+    compression: ChunkCompression::None,
 };
 
 /// Reads every item of the stream: the messages, and the errors in order.
@@ -83,9 +85,17 @@ fn temp_path(dir: &tempfile::TempDir, name: &str) -> PathBuf {
 #[test]
 fn round_trip_keeps_messages_order_topics_and_counts() {
     let dir = tempfile::tempdir().unwrap();
+    let mut sizes = Vec::new();
     for (name, options) in [
         ("default.mcap", BagWriteOptions::default()),
         ("small_chunks.mcap", SMALL_CHUNKS),
+        (
+            "zstd_chunks.mcap",
+            BagWriteOptions {
+                compression: ChunkCompression::Zstd,
+                ..SMALL_CHUNKS
+            },
+        ),
     ] {
         let path = temp_path(&dir, name);
         let written = write_sample_bag(&path, options, 3);
@@ -101,7 +111,9 @@ fn round_trip_keeps_messages_order_topics_and_counts() {
         let (read, errors) = read_all(&reader);
         assert!(errors.is_empty(), "{name}: {errors:?}");
         assert_eq!(read, written, "{name}");
+        sizes.push(std::fs::metadata(&path).unwrap().len());
     }
+    assert!(sizes[2] < sizes[1], "zstd chunks are compressed: {sizes:?}");
 }
 
 #[test]

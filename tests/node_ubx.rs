@@ -223,8 +223,7 @@ fn ubx_node_and_filter_node_give_the_replay_of_the_converted_bag() {
         TruthSource::None,
         &ReplayOptions {
             out_bag: Some(&replayed),
-            csv: None,
-            score_interval_s: 0.0,
+            ..ReplayOptions::default()
         },
         |_| {},
     )

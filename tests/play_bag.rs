@@ -19,7 +19,8 @@ use adaptive_gnss_ins::ros::bag::BagReader;
 use adaptive_gnss_ins::ros::cdr;
 use adaptive_gnss_ins::ros::msg::{Clock, GnssMeasurements, Imu, Odometry, RosMessage};
 use adaptive_gnss_ins::sim::{Scenario, ScenarioSpec};
-use adaptive_gnss_ins::tools::replay::{replay, ReplayOptions, ReplayResult, TruthSource};
+use adaptive_gnss_ins::tools::bag_run::BagRun;
+use adaptive_gnss_ins::tools::replay::{replay, ReplayOptions, TruthSource};
 use adaptive_gnss_ins::tools::simulate::{simulate_with, SimulateOptions};
 use netns_support::reexec_in_private_netns;
 use odometry_support::{decoded, largest_difference};
@@ -199,10 +200,7 @@ fn loose_node_with_velocities_records_the_replay_solution() {
         &["/imu", "/gnss/fix", "/gnss/velocity"],
         2,
     );
-    assert_eq!(
-        replayed.problems.velocities.paired,
-        summary.velocities as u64
-    );
+    assert_eq!(replayed.velocities().paired, summary.velocities as u64);
 }
 
 /// Plays `bag` into `gnss_ins_node --record` (the default parameters but `overrides`,
@@ -213,7 +211,7 @@ fn node_records_the_replay_solution(
     overrides: &[(&str, &str)],
     wait_for: &[&str],
     domain_offset: u16,
-) -> ReplayResult {
+) -> BagRun {
     let dir = tempfile::tempdir().unwrap();
     let recorded = dir.path().join("node.mcap");
     let replayed = dir.path().join("replay.mcap");
@@ -279,8 +277,7 @@ fn node_records_the_replay_solution(
         TruthSource::None,
         &ReplayOptions {
             out_bag: Some(&replayed),
-            csv: None,
-            score_interval_s: 0.0,
+            ..ReplayOptions::default()
         },
         |_| {},
     )

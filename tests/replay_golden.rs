@@ -52,9 +52,8 @@ fn golden_csv() -> PathBuf {
 /// number of solutions.
 fn replay_fixture(out: &Path) -> usize {
     let options = ReplayOptions {
-        out_bag: None,
         csv: Some(out),
-        score_interval_s: 0.0,
+        ..ReplayOptions::default()
     };
     let result = replay(
         &fixture_bag(),

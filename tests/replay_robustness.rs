@@ -1,7 +1,10 @@
 //! `gnss_ins replay` on damaged or unexpected bags: a truncated bag and a corrupt chunk
 //! give partial results and name the damage; unknown topics, topics of an unexpected type
 //! and messages that do not decode are counted and skipped; a bag with no IMU fails with
-//! a clear message. The binary exits non-zero only when nothing usable is left.
+//! a clear message. Replay runs the node's adapter: one IMU stamp far ahead costs a reset
+//! (the node's time-jump rule), not the rest of the bag; a solution with a non-finite
+//! value is counted and not written. The binary exits non-zero when nothing usable is
+//! left or when most IMU samples did not reach the filter.
 //!
 //! The bags are made from the golden fixture (tests/data/fixture_small.mcap, 36 s).
 
@@ -9,18 +12,21 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use adaptive_gnss_ins::config::Config;
+use adaptive_gnss_ins::engine::RejectionReason;
 use adaptive_gnss_ins::ros::bag::{BagReader, BagWriteOptions, BagWriter};
+use adaptive_gnss_ins::ros::cdr;
 use adaptive_gnss_ins::ros::msg::{
     DiagnosticArray, GnssMeasurements, Imu, NavSatFix, NoiseEstimates, Odometry, RosMessage,
 };
+use adaptive_gnss_ins::tools::bag_run::BagRun;
 use adaptive_gnss_ins::tools::replay::TruthSource;
-use adaptive_gnss_ins::tools::replay::{replay, ReplayError, ReplayOptions, ReplayResult};
+use adaptive_gnss_ins::tools::replay::{replay, ReplayError, ReplayOptions};
 
 fn fixture_bag() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/fixture_small.mcap")
 }
 
-fn replay_bag(bag: &Path) -> Result<ReplayResult, ReplayError> {
+fn replay_bag(bag: &Path) -> Result<BagRun, ReplayError> {
     replay(
         bag,
         &Config::default(),
@@ -40,6 +46,18 @@ fn gnss_ins(args: &[&std::ffi::OsStr]) -> Output {
 
 fn stderr(output: &Output) -> String {
     String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+/// Runs `gnss_ins replay BAG --csv CSV`; returns its output and its stderr.
+fn replay_to_csv(bag: &Path, csv: &Path) -> (Output, String) {
+    let output = gnss_ins(&[
+        "replay".as_ref(),
+        bag.as_os_str(),
+        "--csv".as_ref(),
+        csv.as_os_str(),
+    ]);
+    let text = stderr(&output);
+    (output, text)
 }
 
 /// Adds `topic` to `writer` with the type `type_name` (one of the fixture's types).
@@ -96,6 +114,46 @@ fn copy_fixture(
             .unwrap();
     }
     writer.finish().unwrap();
+}
+
+/// Copies the fixture to `out` with each /imu message `k` changed by `edit(k, message)`,
+/// the other messages kept.
+fn copy_fixture_imu_edited(out: &Path, mut edit: impl FnMut(u64, &mut Imu)) {
+    let edited: Vec<Vec<u8>> = BagReader::open(fixture_bag())
+        .unwrap()
+        .messages()
+        .unwrap()
+        .map(Result::unwrap)
+        .filter(|m| m.topic == "/imu")
+        .zip(0..)
+        .map(|(m, k)| {
+            let mut imu: Imu = cdr::decode(&m.data).unwrap();
+            edit(k, &mut imu);
+            cdr::encode(&imu).unwrap()
+        })
+        .collect();
+    copy_fixture(
+        out,
+        BagWriteOptions::default(),
+        |_| {},
+        |topic, k| {
+            if topic == "/imu" {
+                Copy::Replace(edited[k as usize].clone())
+            } else {
+                Copy::Keep
+            }
+        },
+    );
+}
+
+/// The rows of a solution CSV as numbers (without the header).
+fn csv_rows(path: &Path) -> Vec<Vec<f64>> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect()
 }
 
 /// Copies the fixture to `out` with every /imu message handled as `imu` says, the other
@@ -170,6 +228,7 @@ fn a_corrupt_chunk_is_skipped_and_the_rest_is_replayed() {
     // Small chunks so that one corrupt chunk is a small part of the bag.
     let small_chunks = BagWriteOptions {
         chunk_size_bytes: 64 * 1024,
+        ..BagWriteOptions::default()
     };
     let bag = dir.path().join("chunks.mcap");
     copy_fixture(&bag, small_chunks, |_| {}, |_, _| Copy::Keep);
@@ -324,4 +383,159 @@ fn a_file_that_is_not_a_bag_fails_with_the_reason() {
         "{}",
         stderr(&output)
     );
+}
+
+/// Issue 12, item 14: one IMU sample stamped 10⁶ s ahead made replay reject every later
+/// sample as out of order and exit 0 with the solutions of the first 15 s. Replay now
+/// applies the node's time-jump rule: the filter resets once and goes on to the end.
+#[test]
+fn one_imu_sample_stamped_far_ahead_costs_a_reset_not_the_rest_of_the_bag() {
+    let full = replay_bag(&fixture_bag()).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let bag = dir.path().join("ahead.mcap");
+    // The sample at 15 s, while driving.
+    copy_fixture_imu_edited(&bag, |k, imu| {
+        if k == 1500 {
+            imu.header.stamp.sec += 1_000_000;
+        }
+    });
+    let result = replay_bag(&bag).unwrap();
+    assert_eq!(result.counts.time_jump_resets, 1);
+    assert_eq!(
+        result.rejections.count(RejectionReason::ImuOutOfOrder),
+        0,
+        "the samples after the jump are used"
+    );
+    assert!(
+        result.report.solutions > full.report.solutions * 8 / 10,
+        "{} of {} solutions",
+        result.report.solutions,
+        full.report.solutions
+    );
+
+    let csv = dir.path().join("ahead.csv");
+    let (output, text) = replay_to_csv(&bag, &csv);
+    assert!(output.status.success(), "{text}");
+    assert!(text.contains("time_jump_resets"), "{text}");
+    let last_t_s = csv_rows(&csv).last().unwrap()[0];
+    assert!(last_t_s > 35.9, "the solutions end at {last_t_s} s");
+}
+
+/// The other half of item 14: a replay that loses most of its IMU samples (here the IMU
+/// clock freezes at 15 s, so every later sample repeats a stamp) says so and exits
+/// non-zero, keeping what it wrote.
+#[test]
+fn a_replay_that_drops_most_imu_samples_fails_and_keeps_its_outputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let bag = dir.path().join("frozen.mcap");
+    let mut frozen = None;
+    copy_fixture_imu_edited(&bag, |k, imu| {
+        if k >= 1500 {
+            imu.header.stamp = *frozen.get_or_insert(imu.header.stamp);
+        }
+    });
+    let result = replay_bag(&bag).unwrap();
+    assert_eq!(result.imu_dropped("/imu"), (2100, 3601));
+
+    let csv = dir.path().join("frozen.csv");
+    let (output, text) = replay_to_csv(&bag, &csv);
+    assert!(!output.status.success(), "{text}");
+    assert!(
+        text.contains("2100 of the 3601 IMU messages did not reach the filter"),
+        "{text}"
+    );
+    assert_eq!(csv_rows(&csv).len(), result.report.solutions);
+}
+
+/// Every number of an Odometry.
+fn odometry_values(o: &Odometry) -> Vec<f64> {
+    let (p, t) = (&o.pose.pose, &o.twist.twist);
+    let mut values = vec![
+        p.position.x,
+        p.position.y,
+        p.position.z,
+        p.orientation.x,
+        p.orientation.y,
+        p.orientation.z,
+        p.orientation.w,
+        t.linear.x,
+        t.linear.y,
+        t.linear.z,
+        t.angular.x,
+        t.angular.y,
+        t.angular.z,
+    ];
+    values.extend(o.pose.covariance);
+    values.extend(o.twist.covariance);
+    values
+}
+
+/// Issue 12, item 7: a gyro sample of 10¹⁰ rad/s every 100 samples made replay write
+/// solutions with non-finite covariances and negative variances (NaN σ in the CSV).
+/// Replay now has the node's guard: they are counted and not written, to the bag or the
+/// CSV.
+#[test]
+fn solutions_with_a_non_finite_value_or_a_negative_variance_are_counted_and_not_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let bag = dir.path().join("spikes.mcap");
+    copy_fixture_imu_edited(&bag, |k, imu| {
+        if k % 100 == 50 {
+            imu.angular_velocity.x = 1e10;
+        }
+    });
+    let csv = dir.path().join("spikes.csv");
+    let out = dir.path().join("spikes_out.mcap");
+    let options = ReplayOptions {
+        out_bag: Some(&out),
+        csv: Some(&csv),
+        ..ReplayOptions::default()
+    };
+    let result = replay(
+        &bag,
+        &Config::default(),
+        TruthSource::None,
+        &options,
+        |_| {},
+    )
+    .unwrap();
+    let non_finite = result.counts.non_finite_outputs;
+    let negative = result.counts.negative_variance_outputs;
+    assert!(
+        non_finite + negative > 100,
+        "the bag must provoke bad solutions: {non_finite}, {negative}"
+    );
+
+    let (output, text) = replay_to_csv(&bag, &dir.path().join("spikes_cli.csv"));
+    assert!(output.status.success(), "{text}");
+    assert!(
+        text.contains("solutions with a negative variance were not written"),
+        "{text}"
+    );
+    let rows = csv_rows(&csv);
+    assert!(!rows.is_empty());
+    assert_eq!(rows.len(), result.report.solutions);
+    assert!(rows.iter().flatten().all(|v| v.is_finite()));
+    let (mut odometry, mut fixes) = (0, 0);
+    for m in BagReader::open(&out).unwrap().messages().unwrap() {
+        let m = m.unwrap();
+        match m.topic.as_str() {
+            "/odometry" => {
+                odometry += 1;
+                let o: Odometry = cdr::decode(&m.data).unwrap();
+                assert!(odometry_values(&o).iter().all(|v| v.is_finite()), "{o:?}");
+                let (pose, twist) = (&o.pose.covariance, &o.twist.covariance);
+                assert!((0..6).all(|k| pose[7 * k] >= 0.0 && twist[7 * k] >= 0.0));
+            }
+            "/fix" => {
+                fixes += 1;
+                let f: NavSatFix = cdr::decode(&m.data).unwrap();
+                let mut values = vec![f.latitude, f.longitude, f.altitude];
+                values.extend(f.position_covariance);
+                assert!(values.iter().all(|v| v.is_finite()), "{f:?}");
+                assert!((0..3).all(|k| f.position_covariance[4 * k] >= 0.0));
+            }
+            _ => {}
+        }
+    }
+    assert_eq!((odometry, fixes), (rows.len(), rows.len()));
 }

@@ -14,7 +14,8 @@ use adaptive_gnss_ins::ros::msg::{
     TwistWithCovarianceStamped,
 };
 use adaptive_gnss_ins::sim::{Scenario, ScenarioSpec};
-use adaptive_gnss_ins::tools::replay::{replay, ReplayOptions, ReplayResult, TruthSource};
+use adaptive_gnss_ins::tools::bag_run::BagRun;
+use adaptive_gnss_ins::tools::replay::{replay, ReplayOptions, TruthSource};
 use adaptive_gnss_ins::tools::simulate::{self, simulate_with, SimulateOptions, SimulateSummary};
 
 fn root() -> &'static Path {
@@ -41,11 +42,10 @@ fn simulated(dir: &Path, name: &str, velocity: bool) -> (PathBuf, SimulateSummar
 }
 
 /// Replays `bag` loosely coupled, scored against its `/ground_truth`, writing `csv`.
-fn replay_loose(bag: &Path, csv: &Path) -> ReplayResult {
+fn replay_loose(bag: &Path, csv: &Path) -> BagRun {
     let options = ReplayOptions {
-        out_bag: None,
         csv: Some(csv),
-        score_interval_s: 0.0,
+        ..ReplayOptions::default()
     };
     let truth = TruthSource::Topic(simulate::TRUTH_TOPIC.to_owned());
     replay(bag, &loose_config(), truth, &options, |_| {}).unwrap()
@@ -65,17 +65,17 @@ fn replay_joins_every_velocity_with_its_fix_and_uses_it() {
 
     let a = replay_loose(&with, &dir.path().join("with.csv"));
     let b = replay_loose(&without, &dir.path().join("without.csv"));
-    let v = a.problems.velocities;
+    let v = a.velocities();
     assert_eq!(
         v.paired, summary.velocities as u64,
         "every velocity joined: {v:?}"
     );
     assert_eq!((v.unpaired, v.foreign_frame), (0, 0), "{v:?}");
     assert_eq!(a.problems.used(simulate::VELOCITY_TOPIC), v.paired);
-    assert_eq!(b.problems.velocities.paired, 0);
+    assert_eq!(b.velocities().paired, 0);
 
     // Scored over the same span: from the later of the two first scored solutions.
-    let first_t_s = |r: &ReplayResult| r.report.errors.first().unwrap().1.t_s;
+    let first_t_s = |r: &BagRun| r.report.errors.first().unwrap().1.t_s;
     let from_t_s = first_t_s(&a).max(first_t_s(&b));
     let (sa, sb) = (a.report.summary(from_t_s), b.report.summary(from_t_s));
     eprintln!(
@@ -172,9 +172,9 @@ fn replay_does_not_depend_on_whether_a_fix_or_its_velocity_comes_first() {
 
     let a = replay_loose(&first, &dir.path().join("first.csv"));
     let b = replay_loose(&last, &dir.path().join("last.csv"));
-    assert_eq!(a.problems.velocities, b.problems.velocities);
-    assert_eq!(a.problems.velocities.paired, summary.fixes as u64);
-    assert_eq!(a.problems.velocities.unpaired, 0);
+    assert_eq!(a.velocities(), b.velocities());
+    assert_eq!(a.velocities().paired, summary.fixes as u64);
+    assert_eq!(a.velocities().unpaired, 0);
     let csv_a = std::fs::read_to_string(dir.path().join("first.csv")).unwrap();
     let csv_b = std::fs::read_to_string(dir.path().join("last.csv")).unwrap();
     assert!(

@@ -1,6 +1,7 @@
 //! The real recording walk_0827 (../shared/data/walk_0827) converted in-process by the
-//! `gnss_ins convert` code and run through the tightly-coupled EKF on the engine path of
-//! `gnss_ins compare`, against the receiver's RTK solution (its fixed epochs).
+//! `gnss_ins convert` code and run through the tightly-coupled EKF on the path of
+//! `gnss_ins replay` and `compare` (the ROS adapter), against the receiver's RTK solution
+//! (its fixed epochs).
 
 mod walk_0827_support;
 
@@ -9,16 +10,22 @@ use std::sync::OnceLock;
 
 use adaptive_gnss_ins::config::Config;
 use adaptive_gnss_ins::eval::ErrorSummary;
+use adaptive_gnss_ins::eval::TruthSample;
 use adaptive_gnss_ins::gnss::ionosphere::IonosphereMode;
+use adaptive_gnss_ins::gnss::time_scale::DEFAULT_GPS_UTC_LEAP_S;
+use adaptive_gnss_ins::ins::ImuSample;
+use adaptive_gnss_ins::ros::adapter::{Input, InputMessage};
+use adaptive_gnss_ins::ros::bag::BagReader;
+use adaptive_gnss_ins::tools::bag_inputs::{BagInput, BagInputs, BagTopics};
 use adaptive_gnss_ins::tools::convert::{
     convert, ConvertOptions, EphemerisMode, GnssSource, ImuInput, ImuTime, TruthInput,
 };
 use adaptive_gnss_ins::tools::imu_csv::{AccelUnit, GyroUnit, ImuCsvFormat};
-use adaptive_gnss_ins::tools::replay::bag_inputs;
-use adaptive_gnss_ins::tools::session::{Session, SessionInput};
+use adaptive_gnss_ins::tools::replay::{replay, ReplayOptions, TruthSource};
+use adaptive_gnss_ins::tools::scoring::Reference;
+use adaptive_gnss_ins::tools::session::SessionInput;
 use adaptive_gnss_ins::tools::simulate::TRUTH_TOPIC;
-use adaptive_gnss_ins::tools::spp_run::run_spp;
-use adaptive_gnss_ins::tools::time_scale::DEFAULT_GPS_UTC_LEAP_S;
+use adaptive_gnss_ins::tools::spp_run::{bag_spp_inputs, run_spp};
 
 /// The data set README: NAV-PVT height − hMSL.
 const GEOID_SEPARATION_M: f64 = -21.387;
@@ -98,10 +105,23 @@ fn bag() -> &'static Path {
     })
 }
 
-fn inputs() -> Vec<SessionInput> {
-    bag_inputs(bag(), Some(TRUTH_TOPIC.to_owned()))
-        .unwrap()
-        .collect()
+/// The bag's IMU samples and reference samples.
+fn imu_and_truth() -> (Vec<ImuSample>, Vec<TruthSample>) {
+    let reader = BagReader::open(bag()).unwrap();
+    let mut imu = Vec::new();
+    let mut truth = Vec::new();
+    for item in BagInputs::new(
+        reader.messages().unwrap(),
+        BagTopics::default(),
+        &[Input::Imu],
+    ) {
+        match item {
+            BagInput::Message(InputMessage::Imu(m)) => imu.push(ImuSample::try_from(&m).unwrap()),
+            BagInput::Reference(Reference::Truth(t)) => truth.push(t),
+            _ => {}
+        }
+    }
+    (imu, truth)
 }
 
 fn correlation(a: &[f64], b: &[f64]) -> f64 {
@@ -115,21 +135,7 @@ fn correlation(a: &[f64], b: &[f64]) -> f64 {
 
 #[test]
 fn imu_axes_are_confirmed_by_gravity_turns_and_travel() {
-    let inputs = inputs();
-    let imu: Vec<_> = inputs
-        .iter()
-        .filter_map(|i| match i {
-            SessionInput::Imu(s) => Some(*s),
-            _ => None,
-        })
-        .collect();
-    let truth: Vec<_> = inputs
-        .iter()
-        .filter_map(|i| match i {
-            SessionInput::Truth(t) => Some(*t),
-            _ => None,
-        })
-        .collect();
+    let (imu, truth) = imu_and_truth();
     // Gravity: the mean specific force over the first 5 s (at rest) points up.
     let t0 = imu[0].t_s;
     let rest: Vec<_> = imu.iter().filter(|s| s.t_s < t0 + 5.0).collect();
@@ -217,11 +223,9 @@ fn summary(by: &std::collections::BTreeMap<String, ErrorSummary>, key: &str) -> 
 #[test]
 fn tightly_coupled_ekf_stays_within_budget() {
     let config = config();
-    let mut session = Session::new(config.clone(), 0.0, None);
-    for input in inputs() {
-        session.push(input);
-    }
-    let report = session.finish();
+    let truth = TruthSource::Topic(TRUTH_TOPIC.to_owned());
+    let run = replay(bag(), &config, truth, &ReplayOptions::default(), |_| {}).unwrap();
+    let report = &run.report;
     let by = report.summary_by_environment(f64::NEG_INFINITY);
     let fixed = summary(&by, "rtk_fixed");
     let first_scored_t_s = report
@@ -232,10 +236,12 @@ fn tightly_coupled_ekf_stays_within_budget() {
     // Our single-point solution on the same measurements and the same epochs (those
     // after the filter started), with one receiver clock as the filter.
     let spp = run_spp(
-        inputs().into_iter().filter(|i| match i {
-            SessionInput::Gnss(e) => e.t_s >= first_scored_t_s,
-            _ => true,
-        }),
+        bag_spp_inputs(bag(), Some(TRUTH_TOPIC.to_owned()))
+            .unwrap()
+            .filter(|i| match i {
+                SessionInput::Gnss(e) => e.t_s >= first_scored_t_s,
+                _ => true,
+            }),
         &config,
     );
     let spp_fixed = summary(&spp.summary_by_label(), "rtk_fixed");
@@ -248,7 +254,7 @@ fn tightly_coupled_ekf_stays_within_budget() {
         spp_fixed.epochs,
         spp_fixed.pos_rmse_horizontal_m,
         spp_fixed.pos_rmse_u_m,
-        report.rejected.len()
+        run.rejections.total()
     );
     assert!(fixed.epochs > 250, "{} fixed epochs scored", fixed.epochs);
     assert!(

@@ -156,7 +156,7 @@ pub struct AdaptiveUpdate {
 ///
 /// Choice: the posterior is the Joseph form (I − K̄H)(P⁻/α)(I − K̄H)ᵀ + K̄R̄K̄ᵀ. The paper's
 /// eq. (16), P = P⁻ − K̄HP⁻, keeps the *uninflated* P⁻; the adaptive filter it cites
-/// (Yang et al. 2001, its ref. [14]) uses (I − K̄H)P⁻/α, the covariance of the estimate
+/// (Yang et al. 2001, its ref. \[14\]) uses (I − K̄H)P⁻/α, the covariance of the estimate
 /// the gain actually produces when the prior covariance is P⁻/α. With α = 1 both coincide.
 pub fn adaptive_update(
     innovation: &DVector<f64>,

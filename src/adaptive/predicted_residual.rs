@@ -36,7 +36,7 @@ pub fn predicted_residual_statistic(
 ///
 /// Choice: each element is standardized by its own marginal σ (the diagonal of
 /// P_V̄ = H P⁻ Hᵀ + R, R the nominal, not yet inflated, covariance), which is what the
-/// bifactor literature the paper cites ([24]) uses; it needs no decorrelation.
+/// bifactor literature the paper cites (\[24\]) uses; it needs no decorrelation.
 pub fn standardized_residuals(
     predicted_residual: &DVector<f64>,
     residual_covariance: &DMatrix<f64>,

@@ -98,7 +98,7 @@ impl ConfigError {
         }
     }
 
-    /// At most [`QUOTED_CHARS`] characters of a text from the input, for a message.
+    /// At most `QUOTED_CHARS` characters of a text from the input, for a message.
     ///
     /// Choice: an error quotes a short prefix of what it refers to and its length, so
     /// that a 100 MB value does not come back on stderr, `/rosout` or in a service reply.

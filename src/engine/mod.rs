@@ -21,7 +21,6 @@
 mod adaptation;
 pub mod adaptive_noise;
 mod filter_state;
-pub mod fix_pairing;
 mod initializer;
 mod output;
 pub mod q_scaling;

@@ -11,6 +11,7 @@ pub mod rinex_nav;
 pub mod rinex_obs;
 pub mod rinex_spp;
 pub mod spp;
+pub mod time_scale;
 pub mod ubx;
 
-pub use observation::{Constellation, GnssEpoch, Klobuchar, SatId, SatObservation};
+pub use observation::{CarrierPhase, Constellation, GnssEpoch, Klobuchar, SatId, SatObservation};

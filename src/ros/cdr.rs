@@ -72,16 +72,23 @@ pub enum CdrError {
 /// `00 01 00 00` followed by the little-endian CDR body, without trailing padding.
 pub fn encode<T: Serialize>(value: &T) -> Result<Vec<u8>, CdrError> {
     let mut payload = Vec::with_capacity(64);
+    encode_into(&mut payload, value)?;
+    Ok(payload)
+}
+
+/// [`encode`] into `payload`, replacing its content; a buffer reused from one message to
+/// the next is allocated only when a message is larger than any before.
+pub fn encode_into<T: Serialize>(payload: &mut Vec<u8>, value: &T) -> Result<(), CdrError> {
+    payload.clear();
     payload.extend_from_slice(&CDR_LE);
     payload.extend_from_slice(&[0x00, 0x00]);
     // A fresh serializer counts alignment from the body's first byte (see module doc).
-    cdr_encoding::to_writer::<T, LittleEndian, _>(&mut payload, value).map_err(|source| {
+    cdr_encoding::to_writer::<T, LittleEndian, _>(&mut *payload, value).map_err(|source| {
         CdrError::Serialize {
             type_name: std::any::type_name::<T>(),
             source,
         }
-    })?;
-    Ok(payload)
+    })
 }
 
 /// Deserializes a ROS 2 payload in `CDR_LE` or `CDR_BE` encapsulation. The two options

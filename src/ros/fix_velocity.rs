@@ -1,11 +1,10 @@
-//! `gnss/fix` joined with the `gnss/velocity` of its stamp: the core's
-//! [`FixPairing`](crate::engine::fix_pairing::FixPairing) over the converted messages,
-//! plus the rule which velocity frames are usable. The live node and `gnss_ins replay`
-//! both join through [`FixVelocityJoin`], so a bag replays as the node runs it.
+//! `gnss/fix` joined with the `gnss/velocity` of its stamp: the [`FixPairing`] over the
+//! converted messages, plus the rule which velocity frames are usable. The adapter joins
+//! through [`FixVelocityJoin`] for the live node and `gnss_ins replay` alike.
 
-use crate::engine::fix_pairing::{FixPairing, Released, Stamped};
 use crate::engine::GnssFix;
 use crate::ros::convert::GnssVelocity;
+use crate::ros::fix_pairing::{FixPairing, Released, Stamped};
 
 /// A fix with the `frame_id` of its NavSatFix.
 #[derive(Debug, Clone, PartialEq)]
@@ -50,7 +49,7 @@ pub struct Joined {
     pub velocity: VelocityUse,
 }
 
-/// Joins fixes and velocities (see [`crate::engine::fix_pairing`] for when a fix waits).
+/// Joins fixes and velocities (see [`crate::ros::fix_pairing`] for when a fix waits).
 #[derive(Debug, Clone)]
 pub struct FixVelocityJoin {
     pairing: FixPairing<FramedFix, GnssVelocity>,

@@ -14,24 +14,25 @@ use std::collections::VecDeque;
 
 use nalgebra::{Matrix3, Vector3};
 use rand_chacha::rand_core::Rng;
-use thiserror::Error;
 
 use crate::earth::{earth_rate_enu_rad_s, ecef_to_llh, llh_to_ecef, rot_ecef_to_enu};
 use crate::engine::GnssFix;
-use crate::gnss::geometry::{elevation_azimuth, line_of_sight, GnssModelError};
+use crate::gnss::geometry::{elevation_azimuth, line_of_sight};
 use crate::gnss::spp::{solve_spp, SigmaModel, SppConfig, SppSolution};
 use crate::gnss::{GnssEpoch, SatId};
 use crate::ins::ImuSample;
+use crate::sim::carrier::CarrierTracks;
 use crate::sim::constellation::{
-    AtmosphereTruth, GpsConstellation, ObservationNoise, ReceiverTruth, SimError,
+    AtmosphereTruth, GpsConstellation, ObservationNoise, ReceiverTruth,
 };
 use crate::sim::environment::Environment;
 use crate::sim::receiver_clock::{ReceiverClock, ReceiverClockState};
 use crate::sim::sat_errors::{
     stream_rng, FoliageModels, SatContext, SatErrorGenerator, SatErrorTruth, StreamPurpose,
 };
+use crate::sim::scenario_error::ScenarioError;
 use crate::sim::scenario_spec::ScenarioSpec;
-use crate::sim::{ImuErrorModel, ImuErrorModelError, Trajectory, TrajectoryError, TruthSample};
+use crate::sim::{ImuErrorModel, Trajectory, TruthSample};
 
 /// Floors of the σ model of the receiver-like fix (m, m/s). Choice: the fix weights the
 /// satellites with the scenario's open-sky zenith σ (a receiver's nominal model), floored
@@ -46,35 +47,6 @@ const MAX_FIX_PDOP: f64 = 10.0;
 /// Slack (in periods) when counting the samples of a stream, so that 400 s at 100 Hz gives
 /// 40 001 samples despite rounding.
 const COUNT_SLACK_PERIODS: f64 = 1e-6;
-
-/// Why a scenario could not be built or run.
-#[derive(Debug, Clone, PartialEq, Error)]
-pub enum ScenarioError {
-    /// The YAML does not parse into a spec.
-    #[error("scenario YAML: {message}")]
-    Yaml { message: String },
-    /// No built-in scenario of that name.
-    #[error("no built-in scenario '{name}' (known: {known})")]
-    UnknownBuiltin { name: String, known: String },
-    /// A spec value is out of range.
-    #[error("invalid scenario field {field}: {reason}")]
-    InvalidSpec { field: String, reason: &'static str },
-    /// The trajectory spec was refused.
-    #[error("scenario trajectory: {0}")]
-    Trajectory(#[from] TrajectoryError),
-    /// The IMU error spec was refused.
-    #[error("scenario IMU errors: {0}")]
-    ImuErrors(#[from] ImuErrorModelError),
-    /// The observation simulator failed at an epoch.
-    #[error("GNSS simulation at t = {t_s} s: {source}")]
-    Simulation { t_s: f64, source: SimError },
-    /// The geometry of a satellite could not be computed at an epoch.
-    #[error("satellite geometry at t = {t_s} s: {source}")]
-    Geometry { t_s: f64, source: GnssModelError },
-    /// The antenna position has no geodetic coordinates.
-    #[error("antenna position undefined at t = {t_s} s")]
-    AntennaPosition { t_s: f64 },
-}
 
 /// The truth behind one GNSS epoch, for scoring and tests.
 #[derive(Debug, Clone, PartialEq)]
@@ -268,6 +240,7 @@ impl Scenario {
                 self.spec.gnss.thermal_noise.clone(),
                 self.foliage.clone(),
             ),
+            carrier: CarrierTracks::new(self.seed),
             imu: Stream::new(self.spec.imu.rate_hz, count(self.spec.imu.rate_hz)),
             truth: Stream::new(self.spec.truth_rate_hz, count(self.spec.truth_rate_hz)),
             gnss: Stream::new(self.spec.gnss.rate_hz, count(self.spec.gnss.rate_hz)),
@@ -289,7 +262,7 @@ impl Scenario {
         index: u64,
         t_s: f64,
         clock: ReceiverClockState,
-        sat_errors: &mut SatErrorGenerator,
+        (sat_errors, carrier): (&mut SatErrorGenerator, &mut CarrierTracks),
         out: &mut VecDeque<SimEvent>,
     ) -> Result<(), ScenarioError> {
         let (segment, environment) = self.environment_at(t_s);
@@ -359,6 +332,9 @@ impl Scenario {
                     .pseudorange_rate_mps
                     .map(|r| r + err.pseudorange_rate_error_mps);
                 obs.cn0_dbhz = Some(err.cn0_dbhz);
+                obs.carrier_phase = obs.carrier_phase.map(|phase| {
+                    carrier.receive(obs.sat, index, t_s, phase, err.carrier_phase_error_m)
+                });
                 satellites.push(obs);
                 sat_truths.push(err);
             }
@@ -446,6 +422,7 @@ pub struct ScenarioEvents<'a> {
     clock_rng: rand_chacha::ChaCha8Rng,
     clock_t_s: f64,
     sat_errors: SatErrorGenerator,
+    carrier: CarrierTracks,
     imu: Stream,
     truth: Stream,
     gnss: Stream,
@@ -477,7 +454,7 @@ impl ScenarioEvents<'_> {
                     index,
                     t_s,
                     self.clock.state(),
-                    &mut self.sat_errors,
+                    (&mut self.sat_errors, &mut self.carrier),
                     &mut self.pending,
                 )?;
             }

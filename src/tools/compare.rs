@@ -1,8 +1,166 @@
-//! Runs several filter variants over the same input and tabulates their errors.
+//! Runs several filter configurations over the same bag, in parallel, and tabulates their
+//! errors.
+
+use std::io::{IsTerminal, Write};
+use std::path::Path;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+use std::time::Instant;
 
 use serde::Serialize;
 
+use crate::config::Config;
 use crate::eval::ErrorSummary;
+
+use super::bag_run::BagRunner;
+use super::scoring::SessionReport;
+
+/// Scoring interval of the comparisons (s): every reference sample of a simulated bag
+/// (10 Hz).
+const SCORE_INTERVAL_S: f64 = 0.0;
+
+/// A configuration of a comparison with its name in the table.
+#[derive(Debug, Clone)]
+pub struct NamedConfig {
+    pub name: String,
+    pub config: Config,
+}
+
+/// Runs every configuration over `bag` (scored against its `truth_topic`) and returns one
+/// row and the scoring report per configuration, in their order.
+///
+/// Choice: one worker thread per core (`std::thread::available_parallelism`), each taking
+/// the next configuration and streaming the bag itself through the ROS adapter, as
+/// `replay` does: memory stays that of one replay per worker, and no worker waits for
+/// another's input. Each row's `runtime_s` is the wall time of its own run. Progress goes
+/// to stderr: a live line on a terminal, a line per finished configuration otherwise.
+pub fn compare_bag(
+    bag: &Path,
+    configs: &[NamedConfig],
+    truth_topic: &str,
+) -> Result<Vec<(ComparisonRow, SessionReport)>, String> {
+    let workers = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(configs.len());
+    let next = AtomicUsize::new(0);
+    let progress = Progress::new(configs);
+    eprintln!(
+        "compare: {} configurations over {} on {workers} threads",
+        configs.len(),
+        bag.display()
+    );
+    let results: Mutex<Vec<Option<RunResult>>> = Mutex::new(vec![None; configs.len()]);
+    std::thread::scope(|scope| {
+        for _ in 0..workers {
+            scope.spawn(|| loop {
+                let k = next.fetch_add(1, Ordering::Relaxed);
+                let Some(named) = configs.get(k) else {
+                    break;
+                };
+                let result = run_one(bag, named, truth_topic, |f| progress.update(k, f));
+                progress.finished(k);
+                if let Ok(mut all) = results.lock() {
+                    all[k] = Some(result);
+                }
+            });
+        }
+    });
+    progress.end();
+    let results = results.into_inner().map_err(|e| e.to_string())?;
+    results
+        .into_iter()
+        .zip(configs)
+        .map(|(r, named)| r.unwrap_or_else(|| Err(format!("{}: the run did not end", named.name))))
+        .collect()
+}
+
+/// The row and the scoring report of one configuration, or why its run failed.
+type RunResult = Result<(ComparisonRow, SessionReport), String>;
+
+/// One configuration over the bag.
+fn run_one(
+    bag: &Path,
+    named: &NamedConfig,
+    truth_topic: &str,
+    progress: impl FnMut(f64),
+) -> RunResult {
+    let start = Instant::now();
+    let error = |e: &dyn std::fmt::Display| format!("{}: {e}", named.name);
+    let runner = BagRunner::scoring_only(
+        bag,
+        &named.config,
+        Some(truth_topic.to_owned()),
+        SCORE_INTERVAL_S,
+    )
+    .map_err(|e| error(&e))?;
+    let run = runner
+        .run(|_| Ok::<(), std::convert::Infallible>(()), progress)
+        .map_err(|e| error(&e))?;
+    let runtime = start.elapsed().as_secs_f64();
+    let row = ComparisonRow::new(&named.name, &run.report.summary(f64::NEG_INFINITY), runtime);
+    Ok((row, run.report))
+}
+
+/// The progress of a comparison's runs, shown on stderr.
+struct Progress<'a> {
+    configs: &'a [NamedConfig],
+    /// Fraction done of each run; None before it starts.
+    done: Mutex<Vec<Option<f64>>>,
+    finished: AtomicUsize,
+    live: bool,
+}
+
+impl<'a> Progress<'a> {
+    fn new(configs: &'a [NamedConfig]) -> Self {
+        Self {
+            configs,
+            done: Mutex::new(vec![None; configs.len()]),
+            finished: AtomicUsize::new(0),
+            live: std::io::stderr().is_terminal(),
+        }
+    }
+
+    fn update(&self, k: usize, fraction: f64) {
+        let Ok(mut done) = self.done.lock() else {
+            return;
+        };
+        done[k] = Some(fraction);
+        if self.live {
+            let running: Vec<String> = done
+                .iter()
+                .zip(self.configs)
+                .filter(|(f, _)| f.is_some_and(|f| f < 1.0))
+                .map(|(f, c)| format!("{} {:.0} %", c.name, f.unwrap_or(0.0) * 100.0))
+                .collect();
+            let finished = self.finished.load(Ordering::Relaxed);
+            let mut err = std::io::stderr().lock();
+            let _ = write!(
+                err,
+                "\r\x1b[Kcompare: {finished}/{} done; {}",
+                self.configs.len(),
+                running.join(", ")
+            );
+            let _ = err.flush();
+        }
+    }
+
+    fn finished(&self, k: usize) {
+        let n = self.finished.fetch_add(1, Ordering::Relaxed) + 1;
+        if !self.live {
+            eprintln!(
+                "compare: {} done ({n}/{})",
+                self.configs[k].name,
+                self.configs.len()
+            );
+        }
+    }
+
+    fn end(&self) {
+        if self.live {
+            eprint!("\r\x1b[K");
+        }
+    }
+}
 
 /// One row of a comparison.
 #[derive(Debug, Clone, Serialize)]
@@ -134,6 +292,8 @@ pub struct EnvironmentRow {
     pub environment: String,
     pub epochs: usize,
     pub pos_rmse_horizontal_m: f64,
+    /// Horizontal RMSE after removing the mean offset over the environment's epochs.
+    pub pos_rmse_horizontal_offset_removed_m: f64,
     pub pos_rmse_u_m: f64,
     pub pos_rmse_3d_m: f64,
     pub vel_rmse_3d_mps: f64,
@@ -152,6 +312,7 @@ impl EnvironmentRow {
                 environment: environment.clone(),
                 epochs: s.epochs,
                 pos_rmse_horizontal_m: s.pos_rmse_horizontal_m,
+                pos_rmse_horizontal_offset_removed_m: s.pos_rmse_horizontal_offset_removed_m,
                 pos_rmse_u_m: s.pos_rmse_u_m,
                 pos_rmse_3d_m: s.pos_rmse_3d_m,
                 vel_rmse_3d_mps: s.vel_rmse_3d_mps,
@@ -163,16 +324,24 @@ impl EnvironmentRow {
 /// The comparison by environment as an aligned text table.
 pub fn format_environment_table(rows: &[EnvironmentRow]) -> String {
     let mut out = format!(
-        "{:<14} {:<14} {:>7} {:>8} {:>8} {:>8} {:>9}\n",
-        "filter", "environment", "epochs", "horiz_m", "vert_m", "pos3d_m", "vel_mps"
+        "{:<14} {:<14} {:>7} {:>8} {:>12} {:>8} {:>8} {:>9}\n",
+        "filter",
+        "environment",
+        "epochs",
+        "horiz_m",
+        "horiz_demean",
+        "vert_m",
+        "pos3d_m",
+        "vel_mps"
     );
     for r in rows {
         out.push_str(&format!(
-            "{:<14} {:<14} {:>7} {:>8.3} {:>8.3} {:>8.3} {:>9.4}\n",
+            "{:<14} {:<14} {:>7} {:>8.3} {:>12.3} {:>8.3} {:>8.3} {:>9.4}\n",
             r.filter,
             r.environment,
             r.epochs,
             r.pos_rmse_horizontal_m,
+            r.pos_rmse_horizontal_offset_removed_m,
             r.pos_rmse_u_m,
             r.pos_rmse_3d_m,
             r.vel_rmse_3d_mps

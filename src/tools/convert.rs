@@ -49,8 +49,8 @@ use super::rtklib_pos::{parse_pos, PosQuality};
 use super::simulate::{
     GNSS_TOPIC, IMU_TOPIC, TRUTH_DATUM_TOPIC, TRUTH_ENVIRONMENT_TOPIC, TRUTH_TOPIC,
 };
-use super::time_scale::{gpst_of_week_tow, utc_of_gpst, SECONDS_PER_WEEK};
 use super::time_tag::{parse_time_tag, TimeTagError};
+use crate::gnss::time_scale::{gpst_of_week_tow, utc_of_gpst, SECONDS_PER_WEEK};
 
 /// Frame of the converted IMU samples (the body frame, FLU).
 pub const IMU_FRAME: &str = "base_link";

@@ -2,6 +2,7 @@
 //! spp, play, demo): they read and write files and drive the one engine the live node uses.
 
 pub mod bag_inputs;
+pub mod bag_run;
 pub mod cli;
 pub mod cli_play;
 pub mod cli_real;
@@ -13,9 +14,9 @@ pub mod plots;
 pub mod replay;
 pub mod rtklib_pos;
 pub mod scenario_inputs;
+pub mod scoring;
 pub mod session;
 pub mod simulate;
 pub mod spp_rinex;
 pub mod spp_run;
-pub mod time_scale;
 pub mod time_tag;

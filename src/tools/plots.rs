@@ -24,7 +24,7 @@ use plotters::prelude::*;
 use crate::eval::SolutionError;
 use crate::gnss::SatId;
 
-use super::session::SessionReport;
+use super::scoring::SessionReport;
 
 /// Font family name the figures use (registered once, from the embedded DejaVu Sans).
 const FONT: &str = "sans-serif";
@@ -233,7 +233,7 @@ fn error_figure(
 /// The noise figure: per satellite, each filter's estimated pseudo-range σ and the true
 /// σ; None without σ samples.
 fn noise_figure(runs: &[FilterRun]) -> Option<Figure> {
-    let all: Vec<&super::session::SigmaSample> =
+    let all: Vec<&super::scoring::SigmaSample> =
         runs.iter().flat_map(|r| r.report.sigmas.iter()).collect();
     let sats = busiest_satellites(all.iter().map(|s| s.sat), NOISE_SATELLITES);
     if sats.is_empty() {

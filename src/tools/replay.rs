@@ -1,26 +1,28 @@
-//! `gnss_ins replay`: a recorded bag streamed through the engine (never loaded whole),
-//! with the solutions written to an output bag and/or CSV, and scored against a
-//! reference when one is given.
+//! `gnss_ins replay`: a recorded bag streamed through the ROS adapter as the live node
+//! runs it (never loaded whole), with what the adapter publishes written to an output bag
+//! and/or CSV, and scored against a reference when one is given.
 
-use std::io::Write;
+use std::fs::File;
+use std::io::{BufWriter, Write};
 use std::path::Path;
 
 use crate::config::Config;
 use crate::earth::Llh;
-use crate::engine::Output;
-use crate::eval::{ErrorSummary, TruthSample, TruthTrack};
-use crate::ros::bag::{BagError, BagReader, BagWriter};
-use crate::ros::convert::seconds_to_time;
-use crate::ros::msg::{Imu, NavSatFix, NoiseEstimates, Odometry, RosMessage};
-use crate::ros::outbound;
+use crate::eval::{TruthSample, TruthTrack};
+use crate::ros::adapter::{OutputFrames, Published, RosAdapter};
+use crate::ros::bag::{BagError, BagReader, BagWriteOptions, BagWriter, ChunkCompression};
+use crate::ros::msg::{Imu, NavSatFix, NoiseEstimates, Odometry, RosMessage, TFMessage, Time};
 
-use super::bag_inputs::{BagInputs, BagTopics, ReadProblems};
-use super::session::{Session, SessionReport};
+use super::bag_inputs::BagTopics;
+use super::bag_run::{BagRun, BagRunner};
+use super::scoring::Scorer;
 
 /// Output topics of a replay.
 pub const ODOMETRY_TOPIC: &str = "/odometry";
 pub const FIX_OUT_TOPIC: &str = "/fix";
 pub const NOISE_TOPIC: &str = "/noise_estimates";
+/// Only with `publish_tf`.
+pub const TF_TOPIC: &str = "/tf";
 
 /// Why a replay failed (partial results are kept in the files written so far).
 #[derive(Debug, thiserror::Error)]
@@ -60,14 +62,6 @@ pub enum TruthSource {
     Track(TruthTrack),
 }
 
-/// The result of a replay.
-#[derive(Debug)]
-pub struct ReplayResult {
-    pub report: SessionReport,
-    pub problems: ReadProblems,
-    pub summary: Option<ErrorSummary>,
-}
-
 /// Options of a replay.
 #[derive(Debug, Clone, Default)]
 pub struct ReplayOptions<'a> {
@@ -75,6 +69,11 @@ pub struct ReplayOptions<'a> {
     pub csv: Option<&'a Path>,
     /// Scores at most this often (s); 0 scores every solution that has a reference.
     pub score_interval_s: f64,
+    /// The frames of the written messages (the node's `map_frame`, `base_frame`,
+    /// `publish_tf`).
+    pub frames: OutputFrames,
+    /// Compression of the output bag's chunks.
+    pub compression: ChunkCompression,
 }
 
 /// Replays `bag` with `config`; `progress` is called now and then with the fraction of
@@ -84,11 +83,10 @@ pub fn replay(
     config: &Config,
     truth: TruthSource,
     options: &ReplayOptions,
-    mut progress: impl FnMut(f64),
-) -> Result<ReplayResult, ReplayError> {
+    progress: impl FnMut(f64),
+) -> Result<BagRun, ReplayError> {
     let reader = BagReader::open(bag)?;
     let mut topics = BagTopics::default();
-    let total: u64 = reader.topics().iter().map(|t| t.message_count).sum();
     let track = match truth {
         TruthSource::None => {
             topics.truth = None;
@@ -124,107 +122,107 @@ pub fn replay(
             },
         });
     }
-    let mut inputs = BagInputs::new(reader.messages()?, topics);
-    let mut session = Session::new(config.clone(), options.score_interval_s, track);
-    let mut writer = match options.out_bag {
-        Some(p) => {
-            let mut w = BagWriter::create(p)?;
-            w.add_topic::<Odometry>(ODOMETRY_TOPIC)?;
-            w.add_topic::<NavSatFix>(FIX_OUT_TOPIC)?;
-            w.add_topic::<NoiseEstimates>(NOISE_TOPIC)?;
-            Some(w)
-        }
-        None => None,
+    let mut out = ReplayOutputs::create(options)?;
+    let adapter = RosAdapter::new(config.clone(), options.frames.clone());
+    let adapter = if options.out_bag.is_some() {
+        adapter
+    } else {
+        adapter.without_messages()
     };
-    let mut csv = match options.csv {
-        Some(p) => {
-            let file = std::fs::File::create(p).map_err(|source| ReplayError::Io {
-                path: p.display().to_string(),
-                source,
-            })?;
-            let mut w = std::io::BufWriter::new(file);
-            writeln!(w, "{}", CSV_HEADER).map_err(|source| ReplayError::Io {
-                path: p.display().to_string(),
-                source,
-            })?;
-            Some((w, p))
-        }
-        None => None,
-    };
-    let mut datum = config.output.datum;
-    let mut done = 0u64;
-    for input in inputs.by_ref() {
-        done += 1;
-        if done % 10_000 == 0 && total > 0 {
-            progress(done as f64 / total as f64);
-        }
-        let outputs = session.push(input);
-        for o in &outputs {
-            if let Some(w) = writer.as_mut() {
-                write_output(w, o, &mut datum)?;
-            }
-            if let (Some((w, p)), Output::Solution(sol)) = (csv.as_mut(), o) {
-                write_csv_row(w, sol).map_err(|source| ReplayError::Io {
-                    path: p.display().to_string(),
-                    source,
-                })?;
-            }
-        }
-    }
-    progress(1.0);
-    if let Some(w) = writer {
-        w.finish()?;
-    }
-    if let Some((mut w, p)) = csv {
-        w.flush().map_err(|source| ReplayError::Io {
-            path: p.display().to_string(),
-            source,
-        })?;
-    }
-    let problems = inputs.problems();
-    let report = session.finish();
-    let summary = (!report.errors.is_empty()).then(|| report.summary(f64::NEG_INFINITY));
-    Ok(ReplayResult {
-        report,
-        problems,
-        summary,
-    })
+    let scorer = Scorer::new(options.score_interval_s, track);
+    let runner = BagRunner::open(&reader, topics, adapter, scorer)?;
+    let run = runner.run(|published| out.write(published), progress)?;
+    out.finish()?;
+    Ok(run)
 }
 
-fn write_output(w: &mut BagWriter, o: &Output, datum: &mut Option<Llh>) -> Result<(), ReplayError> {
-    match o {
-        Output::Solution(sol) => {
-            let t = sol.nav.t_s;
-            let Ok(stamp) = seconds_to_time(t) else {
-                return Ok(());
-            };
-            let ns = (t * 1e9).round().max(0.0) as u64;
-            let origin = *datum.get_or_insert(sol.nav.p);
-            w.write(
-                ODOMETRY_TOPIC,
-                &outbound::odometry(sol, &origin, stamp, "map", "base_link"),
-                ns,
-            )?;
-            w.write(
-                FIX_OUT_TOPIC,
-                &outbound::nav_sat_fix(sol, stamp, "base_link"),
-                ns,
-            )?;
-        }
-        Output::Epoch(report) => {
-            let t = report.t_s;
-            if let Ok(stamp) = seconds_to_time(t) {
-                let ns = (t * 1e9).round().max(0.0) as u64;
-                w.write(
-                    NOISE_TOPIC,
-                    &outbound::noise_estimates(report, stamp, "base_link"),
-                    ns,
-                )?;
+/// The output bag and CSV of a replay.
+struct ReplayOutputs {
+    bag: Option<BagWriter>,
+    csv: Option<(BufWriter<File>, String)>,
+}
+
+impl ReplayOutputs {
+    fn create(options: &ReplayOptions) -> Result<Self, ReplayError> {
+        let bag = match options.out_bag {
+            Some(p) => {
+                let bag_options = BagWriteOptions {
+                    compression: options.compression,
+                    ..BagWriteOptions::default()
+                };
+                let mut w = BagWriter::create_with_options(p, bag_options)?;
+                if options.frames.publish_tf {
+                    w.add_topic::<TFMessage>(TF_TOPIC)?;
+                }
+                w.add_topic::<Odometry>(ODOMETRY_TOPIC)?;
+                w.add_topic::<NavSatFix>(FIX_OUT_TOPIC)?;
+                w.add_topic::<NoiseEstimates>(NOISE_TOPIC)?;
+                Some(w)
+            }
+            None => None,
+        };
+        let csv = match options.csv {
+            Some(p) => {
+                let path = p.display().to_string();
+                let io = |source| ReplayError::Io {
+                    path: path.clone(),
+                    source,
+                };
+                let mut w = BufWriter::new(File::create(p).map_err(io)?);
+                writeln!(w, "{}", CSV_HEADER).map_err(io)?;
+                Some((w, path))
+            }
+            None => None,
+        };
+        Ok(Self { bag, csv })
+    }
+
+    /// Writes one published output: its messages into the bag at their stamps, a
+    /// solution's row into the CSV.
+    fn write(&mut self, published: &Published) -> Result<(), ReplayError> {
+        if let Some(w) = self.bag.as_mut() {
+            match published {
+                Published::Solution(s) => {
+                    // A replay with an output bag frames every solution.
+                    if let Some(m) = &s.messages {
+                        let ns = log_time_ns(&m.odometry.header.stamp);
+                        if let Some(tf) = &m.tf {
+                            w.write(TF_TOPIC, tf, ns)?;
+                        }
+                        w.write(ODOMETRY_TOPIC, &m.odometry, ns)?;
+                        w.write(FIX_OUT_TOPIC, &m.fix, ns)?;
+                    }
+                }
+                Published::Epoch(epoch) => {
+                    let noise = &epoch.noise;
+                    w.write(NOISE_TOPIC, noise, log_time_ns(&noise.header.stamp))?;
+                }
             }
         }
-        Output::Status(_) => {}
+        if let (Some((w, path)), Published::Solution(s)) = (self.csv.as_mut(), published) {
+            write_csv_row(w, &s.solution).map_err(|source| ReplayError::Io {
+                path: path.clone(),
+                source,
+            })?;
+        }
+        Ok(())
     }
-    Ok(())
+
+    fn finish(self) -> Result<(), ReplayError> {
+        if let Some(w) = self.bag {
+            w.finish()?;
+        }
+        if let Some((mut w, path)) = self.csv {
+            w.flush()
+                .map_err(|source| ReplayError::Io { path, source })?;
+        }
+        Ok(())
+    }
+}
+
+/// The log time of a message stamped `stamp` (ns since the UNIX epoch; 0 before it).
+fn log_time_ns(stamp: &Time) -> u64 {
+    u64::try_from(stamp.sec).map_or(0, |sec| sec * 1_000_000_000 + u64::from(stamp.nanosec))
 }
 
 const CSV_HEADER: &str = "t_s,lat_deg,lon_deg,height_m,v_e_mps,v_n_mps,v_u_mps,roll_deg,pitch_deg,yaw_deg,sigma_e_m,sigma_n_m,sigma_u_m,clock_bias_m,clock_drift_mps";
@@ -304,14 +302,4 @@ pub fn read_truth_csv(path: &Path) -> Result<TruthTrack, ReplayError> {
         });
     }
     Ok(TruthTrack::new(samples, 1.0))
-}
-
-/// The inputs of a bag (for `compare`, which runs several configurations over one bag).
-pub fn bag_inputs(bag: &Path, truth_topic: Option<String>) -> Result<BagInputs, ReplayError> {
-    let reader = BagReader::open(bag)?;
-    let topics = BagTopics {
-        truth: truth_topic,
-        ..BagTopics::default()
-    };
-    Ok(BagInputs::new(reader.messages()?, topics))
 }

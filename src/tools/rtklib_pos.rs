@@ -11,7 +11,7 @@ use std::collections::BTreeMap;
 
 use nalgebra::Vector3;
 
-use super::time_scale::{gpst_of_week_tow, seconds_of_calendar};
+use crate::gnss::time_scale::{gpst_of_week_tow, seconds_of_calendar};
 
 /// RTKLIB's quality flag Q.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]

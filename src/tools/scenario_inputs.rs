@@ -4,6 +4,7 @@
 use crate::eval::TruthSample;
 use crate::sim::{Scenario, ScenarioError, SimEvent};
 
+use super::scoring::Reference;
 use super::session::SessionInput;
 
 /// The inputs of `scenario`, in time order (the true σ of an epoch just before it); a
@@ -15,27 +16,29 @@ pub fn scenario_inputs(
         let inputs = match event {
             Err(e) => vec![Err(e)],
             Ok(SimEvent::Imu(s)) => vec![Ok(SessionInput::Imu(s))],
-            Ok(SimEvent::Truth(t)) => vec![Ok(SessionInput::Truth(TruthSample {
-                t_s: t.nav.t_s,
-                p: t.nav.p,
-                v_n: Some(t.nav.v_n),
-                q_nb: Some(t.nav.q_nb),
-            }))],
+            Ok(SimEvent::Truth(t)) => {
+                vec![Ok(SessionInput::Reference(Reference::Truth(TruthSample {
+                    t_s: t.nav.t_s,
+                    p: t.nav.p,
+                    v_n: Some(t.nav.v_n),
+                    q_nb: Some(t.nav.q_nb),
+                })))]
+            }
             Ok(SimEvent::Environment { t_s, name, .. }) => {
-                vec![Ok(SessionInput::Environment {
+                vec![Ok(SessionInput::Reference(Reference::Environment {
                     t_s,
                     name: name.to_owned(),
-                })]
+                }))]
             }
             Ok(SimEvent::Gnss {
                 epoch,
                 truth_sigmas,
                 ..
             }) => vec![
-                Ok(SessionInput::TruthSigmas {
+                Ok(SessionInput::Reference(Reference::TruthSigmas {
                     t_s: epoch.t_s,
                     sigmas: truth_sigmas,
-                }),
+                })),
                 Ok(SessionInput::Gnss(epoch)),
             ],
             Ok(SimEvent::Fix(f)) => vec![Ok(SessionInput::Fix(f))],

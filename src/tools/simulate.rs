@@ -31,7 +31,8 @@ use crate::ros::msg::{
 };
 use crate::ros::outbound;
 use crate::sim::constellation::REFERENCE_EPOCH_GPS_TOW_S;
-use crate::sim::scenario::{Scenario, ScenarioError, SimEvent};
+use crate::sim::scenario::{Scenario, SimEvent};
+use crate::sim::ScenarioError;
 
 /// Topic names of simulated bags (and the defaults of `replay`).
 pub const IMU_TOPIC: &str = "/imu";

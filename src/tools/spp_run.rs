@@ -1,6 +1,6 @@
 //! `gnss_ins spp`: our single-point solution of every epoch of a stream of session inputs
-//! (a bag's GNSS measurements and its reference), scored against the reference, for
-//! checking the measurement pipeline without the filter.
+//! (a bag's GNSS measurements and its reference, [`bag_spp_inputs`]), scored against the
+//! reference, for checking the measurement pipeline without the filter.
 //!
 //! Scoring: the reference is interpolated to the epoch's time ([`TruthTrack`]) and the
 //! epoch takes the label (environment) of the reference sample nearest in time.
@@ -16,6 +16,11 @@ use crate::eval::{self, ErrorSummary, SolutionError, TruthSample, TruthTrack};
 use crate::gnss::spp::{solve_spp, SppConfig};
 use crate::gnss::{Constellation, GnssEpoch};
 
+use crate::ros::adapter::{Input, InputMessage};
+use crate::ros::bag::{BagError, BagReader};
+
+use super::bag_inputs::{BagInput, BagInputs, BagTopics};
+use super::scoring::Reference;
 use super::session::SessionInput;
 
 /// Reference samples further apart than this are not interpolated across (s).
@@ -95,6 +100,28 @@ pub fn spp_config(config: &Config) -> SppConfig {
     }
 }
 
+/// The GNSS epochs and the references (on `truth_topic`) of the bag at `path`, for
+/// single-point solutions: no filter runs, so the adapter's handling does not apply;
+/// epochs that do not convert are skipped.
+pub fn bag_spp_inputs(
+    path: &Path,
+    truth_topic: Option<String>,
+) -> Result<impl Iterator<Item = SessionInput>, BagError> {
+    let reader = BagReader::open(path)?;
+    let topics = BagTopics {
+        truth: truth_topic,
+        ..BagTopics::default()
+    };
+    let inputs = BagInputs::new(reader.messages()?, topics, &[Input::Gnss]);
+    Ok(inputs.filter_map(|item| match item {
+        BagInput::Message(InputMessage::Gnss(m)) => {
+            GnssEpoch::try_from(&m).ok().map(SessionInput::Gnss)
+        }
+        BagInput::Reference(r) => Some(SessionInput::Reference(r)),
+        _ => None,
+    }))
+}
+
 /// Solves every GNSS epoch of `inputs` with the constellations and settings of `config`
 /// (one receiver clock, as the filter) and scores the solutions against the reference
 /// samples of `inputs`.
@@ -120,11 +147,11 @@ pub fn run_spp_with(
     for input in inputs {
         match input {
             SessionInput::Gnss(e) => epochs.push(e),
-            SessionInput::Truth(t) => {
+            SessionInput::Reference(Reference::Truth(t)) => {
                 labels.push((t.t_s, environment.clone()));
                 truth.push(t);
             }
-            SessionInput::Environment { name, .. } => environment = name,
+            SessionInput::Reference(Reference::Environment { name, .. }) => environment = name,
             _ => {}
         }
     }

@@ -9,16 +9,7 @@
 //! truncated; a frame cut in the middle of the stream (followed by other data) fails its
 //! checksum and is counted as corrupt.
 
-use super::scanner::Scanner;
-
-/// First sync byte.
-pub const SYNC_1: u8 = 0xB5;
-/// Second sync byte.
-pub const SYNC_2: u8 = 0x62;
-/// Header bytes before the payload (sync ×2, class, id, length ×2).
-pub const HEADER_LEN: usize = 6;
-/// Checksum bytes after the payload.
-pub const CHECKSUM_LEN: usize = 2;
+use super::scanner::{checksum, FrameStats, Scanner, CHECKSUM_LEN, HEADER_LEN, SYNC_1, SYNC_2};
 
 /// One checksum-verified UBX frame, borrowing its payload from the input.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -31,29 +22,6 @@ pub struct UbxFrame<'a> {
     pub payload: &'a [u8],
     /// Byte offset of the frame's first sync byte in the input.
     pub offset: usize,
-}
-
-/// Counts of what the reader met.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct FrameStats {
-    /// Frames with a valid checksum.
-    pub frames: usize,
-    /// Frames rejected for a bad checksum.
-    pub bad_checksum: usize,
-    /// Frames whose declared length runs past the end of the input.
-    pub truncated: usize,
-    /// Headers declaring a payload longer than [`super::MAX_PAYLOAD_LEN`].
-    pub oversized: usize,
-    /// Bytes that are not part of a valid frame (garbage, rejected frames).
-    pub skipped_bytes: usize,
-}
-
-/// The 8-bit Fletcher checksum (CK_A, CK_B) of `bytes`.
-pub fn checksum(bytes: &[u8]) -> (u8, u8) {
-    bytes.iter().fold((0u8, 0u8), |(a, b), &x| {
-        let a = a.wrapping_add(x);
-        (a, b.wrapping_add(a))
-    })
 }
 
 /// Encodes a UBX frame (for tests and tools): sync, header, payload, checksum. None if

@@ -37,7 +37,7 @@ pub use bits::Bits;
 pub use broadcast_nav::{BroadcastNav, BroadcastNavStats};
 pub use epoch::{build_epoch, build_epoch_with};
 pub use error::UbxError;
-pub use frame::{checksum, encode_frame, FrameReader, FrameStats, UbxFrame};
+pub use frame::{encode_frame, FrameReader, UbxFrame};
 pub use galileo_inav::{crc24q, decode_inav_ephemeris, inav_word, InavWord};
 pub use gps_lnav::{
     decode_lnav_ephemeris, decode_lnav_klobuchar, lnav_subframe, nearest_gps_time, LnavSubframe,
@@ -49,6 +49,6 @@ pub use nav_error::NavDataError;
 pub use nav_pvt::{decode_nav_pvt, CarrierSolution, NavPvt};
 pub use rawx::{decode_rawx, RawMeasurement, RawX, RawxBlock, TrackingStatus};
 pub use reader::{read_ubx_log, read_ubx_log_with, UbxLog, UbxLogStats};
-pub use scanner::{MAX_FRAME_LEN, MAX_PAYLOAD_LEN};
+pub use scanner::{checksum, FrameStats, MAX_FRAME_LEN, MAX_PAYLOAD_LEN};
 pub use sfrbx::{decode_sfrbx, Sfrbx};
 pub use stream::UbxFramer;

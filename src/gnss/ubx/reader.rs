@@ -3,10 +3,11 @@
 //! real-time receiver would ([`BroadcastNav`]).
 
 use super::broadcast_nav::{BroadcastNav, BroadcastNavStats};
-use super::frame::{FrameReader, FrameStats};
+use super::frame::FrameReader;
 use super::message::{decode_message, UbxMessage};
 use super::nav_pvt::NavPvt;
 use super::rawx::RawX;
+use super::scanner::FrameStats;
 use crate::gnss::ephemeris::EphemerisStore;
 use crate::gnss::epoch_build::BuiltEpoch;
 use crate::gnss::ionosphere::IonosphereMode;

@@ -10,7 +10,37 @@
 //! payload it declares, so a sync flood costs as much as any other input of its size.
 //! (Checking each candidate by summing its bytes costs up to 64 KiB per candidate.)
 
-use super::frame::{FrameStats, CHECKSUM_LEN, HEADER_LEN, SYNC_1, SYNC_2};
+/// First sync byte.
+pub const SYNC_1: u8 = 0xB5;
+/// Second sync byte.
+pub const SYNC_2: u8 = 0x62;
+/// Header bytes before the payload (sync ×2, class, id, length ×2).
+pub const HEADER_LEN: usize = 6;
+/// Checksum bytes after the payload.
+pub const CHECKSUM_LEN: usize = 2;
+
+/// Counts of what the reader met.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct FrameStats {
+    /// Frames with a valid checksum.
+    pub frames: usize,
+    /// Frames rejected for a bad checksum.
+    pub bad_checksum: usize,
+    /// Frames whose declared length runs past the end of the input.
+    pub truncated: usize,
+    /// Headers declaring a payload longer than [`super::MAX_PAYLOAD_LEN`].
+    pub oversized: usize,
+    /// Bytes that are not part of a valid frame (garbage, rejected frames).
+    pub skipped_bytes: usize,
+}
+
+/// The 8-bit Fletcher checksum (CK_A, CK_B) of `bytes`.
+pub fn checksum(bytes: &[u8]) -> (u8, u8) {
+    bytes.iter().fold((0u8, 0u8), |(a, b), &x| {
+        let a = a.wrapping_add(x);
+        (a, b.wrapping_add(a))
+    })
+}
 
 /// Longest payload accepted (bytes).
 ///
@@ -181,7 +211,7 @@ impl Scanner {
 
 #[cfg(test)]
 mod tests {
-    use super::super::frame::checksum;
+    use super::checksum;
     use super::*;
 
     #[test]

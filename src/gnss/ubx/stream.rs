@@ -9,7 +9,8 @@
 //! most one frame of [`super::MAX_FRAME_LEN`] plus the latest chunk, and twice that
 //! before it is compacted.
 
-use super::frame::{frame_of, FrameStats, UbxFrame};
+use super::frame::{frame_of, UbxFrame};
+use super::scanner::FrameStats;
 use super::scanner::Scanner;
 
 /// A streaming UBX framer; see the module doc.

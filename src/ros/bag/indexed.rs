@@ -28,7 +28,7 @@ use mcap::sans_io::{IndexedReadEvent, IndexedReader, IndexedReaderOptions};
 use mcap::Summary;
 
 use super::error::BagError;
-use super::reader::{channel_infos, BagMessage, ChannelInfo};
+use super::message::{channel_infos, BagMessage, ChannelInfo};
 
 /// Choice: a chunk is trusted to decompress to at most 64 times the file length (zstd on
 /// ROS messages reaches about 10); a corrupt index claiming more gives an error instead

@@ -10,7 +10,7 @@ use mcap::io::MessageReader;
 use mcap::sans_io::LinearReaderOptions;
 
 use super::error::BagError;
-use super::reader::{BagMessage, CDR_ENCODING};
+use super::message::{BagMessage, CDR_ENCODING};
 
 /// The MCAP library's front-to-back reader over `file`, checking chunk CRCs.
 pub(crate) fn message_reader(file: File) -> MessageReader<BufReader<File>> {

@@ -14,6 +14,7 @@ mod definition;
 mod error;
 mod indexed;
 mod linear;
+mod message;
 mod qos;
 mod reader;
 pub mod schemas;
@@ -21,6 +22,7 @@ mod writer;
 
 pub use definition::{full_definition, short_type_name, MissingDefinition};
 pub use error::BagError;
+pub use message::BagMessage;
 pub use qos::{Durability, OfferedQos, Reliability};
-pub use reader::{BagMessage, BagMessages, BagReader, ReadOrder, TopicInfo};
-pub use writer::{BagWriteOptions, BagWriter};
+pub use reader::{BagMessages, BagReader, ReadOrder, TopicInfo};
+pub use writer::{BagWriteOptions, BagWriter, ChunkCompression};

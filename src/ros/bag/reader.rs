@@ -19,19 +19,7 @@ use mcap::Summary;
 use super::error::BagError;
 use super::indexed::IndexedStream;
 use super::linear::{message_reader, LinearStream};
-
-/// One message of a bag, still serialized: decode it with [`crate::ros::cdr::decode`].
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct BagMessage {
-    /// Topic name.
-    pub topic: String,
-    /// ROS type name, e.g. `sensor_msgs/msg/Imu`.
-    pub type_name: String,
-    /// Log (receive) time, ns since the UNIX epoch.
-    pub log_time_ns: u64,
-    /// The ROS 2 payload: CDR encapsulation header + body.
-    pub data: Vec<u8>,
-}
+use super::message::{channel_infos, BagMessage, CDR_ENCODING};
 
 /// A topic of a bag.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -55,15 +43,6 @@ pub enum ReadOrder {
     File,
 }
 
-/// Topic and type of an MCAP channel.
-#[derive(Debug, Clone)]
-pub(crate) struct ChannelInfo {
-    /// Topic name.
-    pub topic: String,
-    /// ROS type name (the schema name; empty without schema).
-    pub type_name: String,
-}
-
 /// How the file is read.
 enum Layout {
     /// Through the summary and its chunk indexes.
@@ -81,9 +60,6 @@ pub struct BagReader {
     /// Topics in channel order.
     topics: Vec<TopicInfo>,
 }
-
-/// Message encoding of ROS 2 channels.
-pub(crate) const CDR_ENCODING: &str = "cdr";
 
 /// MCAP magic bytes at the start of every MCAP file.
 const MCAP_MAGIC: &[u8] = mcap::MAGIC;
@@ -279,25 +255,6 @@ fn check_encodings(path: &Path, summary: &Summary) -> Result<(), BagError> {
         }),
         None => Ok(()),
     }
-}
-
-/// Topic and type of every channel of the summary.
-pub(crate) fn channel_infos(summary: &Summary) -> HashMap<u16, ChannelInfo> {
-    summary
-        .channels
-        .iter()
-        .map(|(id, channel)| {
-            let info = ChannelInfo {
-                topic: channel.topic.clone(),
-                type_name: channel
-                    .schema
-                    .as_ref()
-                    .map(|schema| schema.name.clone())
-                    .unwrap_or_default(),
-            };
-            (*id, info)
-        })
-        .collect()
 }
 
 /// Topics of an indexed file, in channel id order, with the counts of the statistics.

@@ -1,4 +1,5 @@
-//! The `gnss_ins_node` ROS 2 node: DDS subscriptions and publishers around [`NodeCore`].
+//! The `gnss_ins_node` ROS 2 node: DDS subscriptions and publishers around the
+//! [`RosAdapter`] (which `gnss_ins replay` drives from a bag).
 //!
 //! Topics (relative, so `__ns` and remappings apply): subscribes `imu`
 //! (sensor_msgs/Imu), `gnss/measurements` (GnssMeasurements), `gnss/fix` (NavSatFix),
@@ -10,9 +11,7 @@
 
 pub mod clock;
 pub mod dds;
-pub mod handler;
 pub mod input_stats;
-pub mod log_limit;
 pub mod param_server;
 pub mod params;
 pub mod recorder;
@@ -22,7 +21,9 @@ pub mod startup;
 
 use futures::stream::{self, LocalBoxStream, StreamExt};
 
+use crate::ros::adapter::{Published, PublishedSolution, RosAdapter, SolutionMessages};
 use crate::ros::args::NodeArgs;
+use crate::ros::log_limit::LogLimiter;
 use crate::ros::msg::{
     Clock, DiagnosticArray, GnssMeasurements, Imu, Log, NavSatFix, NoiseEstimates, Odometry,
     TFMessage, Time, TwistWithCovarianceStamped,
@@ -31,9 +32,7 @@ use crate::ros::msg::{
 use clock::NodeClock;
 pub use dds::{domain_id_from, DdsOptions, NodeError, DIAGNOSTICS_PERIOD};
 use dds::{events, subscription, Names, Output};
-pub use handler::{NodeCore, OutMsg};
 use input_stats::{InputStats, Stream};
-use log_limit::LogLimiter;
 use param_server::ParameterServer;
 use params::NodeParams;
 use recorder::Recorder;
@@ -64,22 +63,33 @@ struct Outputs {
 }
 
 impl Outputs {
-    fn publish(&mut self, msgs: Vec<OutMsg>, now: Time) {
-        for m in msgs {
+    /// Publishes each output's messages: the TF (with `publish_tf`) before its Odometry.
+    fn publish(&mut self, published: Vec<Published>, now: Time) {
+        for p in published {
             let recorder = &mut self.recorder;
-            let result = match m {
-                OutMsg::Odometry(o) => self.odometry.send(*o, recorder, now),
-                OutMsg::Fix(f) => self.fix.send(f, recorder, now),
-                OutMsg::Noise(n) => self.noise.send(n, recorder, now),
-                OutMsg::Tf(t) => match &self.tf {
-                    Some(tf) => tf.send(t, recorder, now),
-                    None => Ok(()),
-                },
-            };
-            if let Err(e) = result {
-                self.log.warn("publish", &format!("publish failed: {e}"));
+            let log = &mut self.log;
+            match p {
+                Published::Solution(PublishedSolution { messages, .. }) => {
+                    // The node's adapter frames every solution.
+                    let Some(m) = messages else { continue };
+                    let SolutionMessages { odometry, fix, tf } = *m;
+                    if let (Some(t), Some(out)) = (tf, &self.tf) {
+                        log_failure(log, out.send(t, recorder, now));
+                    }
+                    log_failure(log, self.odometry.send(odometry, recorder, now));
+                    log_failure(log, self.fix.send(fix, recorder, now));
+                }
+                Published::Epoch(epoch) => {
+                    log_failure(log, self.noise.send(epoch.noise, recorder, now));
+                }
             }
         }
+    }
+}
+
+fn log_failure(log: &mut LogLimiter, sent: Result<(), String>) {
+    if let Err(e) = sent {
+        log.warn("publish", &format!("publish failed: {e}"));
     }
 }
 
@@ -120,7 +130,7 @@ pub fn run(
     let config = params.config;
     let fqn = node.fully_qualified_name();
     let logger = rosout::logger_name(&fqn);
-    let mut core = NodeCore::new(config, params.frames.clone());
+    let mut core = RosAdapter::new(config, params.frames.clone());
     let mut parameters = ParameterServer::new(params.use_sim_time, params.frames)
         .with_queue_depth(params.queue_depth);
     let mut clock = NodeClock::default();
@@ -232,7 +242,7 @@ pub fn run(
     Ok(())
 }
 
-fn undecodable(core: &mut NodeCore, topic: &str, error: &str) -> Vec<OutMsg> {
+fn undecodable(core: &mut RosAdapter, topic: &str, error: &str) -> Vec<Published> {
     core.on_undecodable(topic, error);
     Vec::new()
 }

@@ -5,7 +5,7 @@
 //! The parameters are the core configuration's (`section.key`, human units, the names of
 //! the parameter file) plus the node's own `use_sim_time`, `map_frame`, `base_frame`,
 //! `publish_tf` and `queue_depth`; their descriptions, ranges and read-only flags come
-//! from the parameter table and [`NODE_PARAMETERS`]. A set request is validated like the
+//! from the parameter table and `NODE_PARAMETERS`. A set request is validated like the
 //! parameter file; only the run-time parameters (and `use_sim_time`) are accepted while
 //! the node runs, every other parameter is read-only and a set is refused with the reason.
 //!
@@ -29,12 +29,12 @@ use serde_yaml::Value;
 use crate::config::{self, Config, ConfigError, Kind};
 use crate::ros::cdr;
 
-use super::log_limit::LogLimiter;
 use super::params::{
     NodeParameter, OutputFrames, BASE_FRAME, DEFAULT_QUEUE_DEPTH, MAP_FRAME, PUBLISH_TF,
     QUEUE_DEPTH, USE_SIM_TIME,
 };
-use super::NodeCore;
+use crate::ros::adapter::RosAdapter;
+use crate::ros::log_limit::LogLimiter;
 
 /// `ListParameters` depth meaning "no limit".
 const DEPTH_RECURSIVE: u64 = 0;
@@ -457,7 +457,7 @@ impl ParameterServer {
         }
     }
 
-    fn set_one(&mut self, core: &mut NodeCore, param: &Parameter) -> Result<(), String> {
+    fn set_one(&mut self, core: &mut RosAdapter, param: &Parameter) -> Result<(), String> {
         oversized(param)?;
         if param.name == USE_SIM_TIME {
             self.use_sim_time = Self::sim_time_value(param)?;
@@ -468,7 +468,7 @@ impl ParameterServer {
     }
 
     /// `set_parameters`: each parameter on its own, one result each.
-    pub fn set(&mut self, core: &mut NodeCore, params: &[Parameter]) -> SetParametersResponse {
+    pub fn set(&mut self, core: &mut RosAdapter, params: &[Parameter]) -> SetParametersResponse {
         if params.len() > MAX_NAMES {
             self.refused(
                 "set_parameters",
@@ -497,7 +497,7 @@ impl ParameterServer {
     /// `set_parameters_atomically`: all or none.
     pub fn set_atomically(
         &mut self,
-        core: &mut NodeCore,
+        core: &mut RosAdapter,
         params: &[Parameter],
     ) -> SetParametersAtomicallyResponse {
         let mut config = core.engine().config().clone();
@@ -696,7 +696,7 @@ mod tests {
     #[test]
     fn set_applies_runtime_parameters_and_refuses_the_rest_with_a_reason() {
         let mut s = ParameterServer::new(false, OutputFrames::default());
-        let mut core = NodeCore::new(Config::default(), OutputFrames::default());
+        let mut core = RosAdapter::new(Config::default(), OutputFrames::default());
         let r = s.set(
             &mut core,
             &[
@@ -752,7 +752,7 @@ mod tests {
     #[test]
     fn set_atomically_is_all_or_nothing() {
         let mut s = ParameterServer::new(false, OutputFrames::default());
-        let mut core = NodeCore::new(Config::default(), OutputFrames::default());
+        let mut core = RosAdapter::new(Config::default(), OutputFrames::default());
         let r = s.set_atomically(
             &mut core,
             &[
@@ -782,7 +782,7 @@ mod tests {
             publish_tf: true,
         };
         let mut s = ParameterServer::new(false, frames);
-        let mut core = NodeCore::new(Config::default(), OutputFrames::default());
+        let mut core = RosAdapter::new(Config::default(), OutputFrames::default());
         let c = Config::default();
         let n = names(&["map_frame", "base_frame", "publish_tf"]);
         let v = s.get(&c, &n).values;
@@ -858,7 +858,7 @@ mod tests {
     #[test]
     fn huge_names_and_values_get_bounded_replies_and_rate_limited_logs() {
         let mut s = ParameterServer::new(false, OutputFrames::default());
-        let mut core = NodeCore::new(Config::default(), OutputFrames::default());
+        let mut core = RosAdapter::new(Config::default(), OutputFrames::default());
         let c = Config::default();
         let huge = "n".repeat(200_000);
         let names: Vec<String> = (0..100).map(|i| format!("{huge}{i}")).collect();

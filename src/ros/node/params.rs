@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use serde_yaml::Value;
 
 use crate::config::{manual::Row, Assignment, Config, ConfigError, Kind, MAX_FILE_BYTES};
+pub use crate::ros::adapter::OutputFrames;
 use crate::ros::args::{NodeArgs, ParameterSource, DEFAULT_NODE_NAME};
 use crate::ros::param_overrides::{node_matches, ParameterOverrides};
 
@@ -175,27 +176,6 @@ impl NodeParameter {
 pub fn reference() -> String {
     let rows: Vec<Row> = NODE_PARAMETERS.iter().map(NodeParameter::row).collect();
     crate::config::manual::reference(&rows) + &crate::ros::ubx_node::params::reference_section()
-}
-
-/// The frames of the node's outputs and whether it publishes them on `/tf`.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct OutputFrames {
-    /// Parent frame of Odometry and TF (default `map`).
-    pub map_frame: String,
-    /// Child frame of Odometry and TF, frame of NavSatFix (default `base_link`).
-    pub base_frame: String,
-    /// Publish the TF `map_frame` → `base_frame` (default false).
-    pub publish_tf: bool,
-}
-
-impl Default for OutputFrames {
-    fn default() -> Self {
-        Self {
-            map_frame: "map".to_owned(),
-            base_frame: "base_link".to_owned(),
-            publish_tf: false,
-        }
-    }
 }
 
 /// What the command line configures: the core's configuration and the node's own

@@ -2,7 +2,7 @@
 //!
 //! A logger in front of env_logger hands every line of this crate that env_logger prints
 //! to the node's event loop, which publishes it on `/rosout` stamped with the node's
-//! time. Repeated warnings are limited before they are logged ([`super::log_limit`]), so
+//! time. Repeated warnings are limited before they are logged ([`crate::ros::log_limit`]), so
 //! `/rosout` carries exactly the lines stderr does.
 
 use std::sync::Mutex;

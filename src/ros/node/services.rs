@@ -18,7 +18,7 @@ use ros2_client::parameters::raw::Parameter;
 
 use super::dds::{dds_error, NodeError};
 use super::param_server::ParameterServer;
-use super::NodeCore;
+use crate::ros::adapter::RosAdapter;
 
 /// The request/reply mapping of the ROS 2 middleware named by `RMW_IMPLEMENTATION`.
 ///
@@ -186,7 +186,7 @@ pub trait ParameterHandler {
 /// `core`'s engine (run-time parameters are set on it).
 pub struct CoreParameters<'a> {
     pub server: &'a mut ParameterServer,
-    pub core: &'a mut NodeCore,
+    pub core: &'a mut RosAdapter,
 }
 
 impl ParameterHandler for CoreParameters<'_> {

@@ -14,8 +14,8 @@
 use std::collections::VecDeque;
 
 use super::params::{TimeBase, UbxAdapterParams, MAX_LEAP_SECONDS};
+use crate::gnss::time_scale::{gpst_of_week_tow, utc_of_gpst};
 use crate::gnss::ubx::RawX;
-use crate::tools::time_scale::{gpst_of_week_tow, utc_of_gpst};
 
 /// Choice: an IMU message older than this (node time) at a GNSS epoch's arrival is too
 /// old to tell the IMU clock by (its rate may have drifted, or the IMU stopped).

@@ -32,10 +32,10 @@ pub use params::{
 use crate::gnss::ephemeris::{GpsTime, SECONDS_PER_WEEK};
 use crate::gnss::ubx::{decode_message, BroadcastNav, RawX, UbxFramer, UbxMessage};
 use crate::ros::convert::{seconds_to_time, time_to_seconds};
+use crate::ros::log_limit::LogLimiter;
 use crate::ros::msg::{
     DiagnosticStatus, GnssMeasurements, Imu, KeyValue, UInt8MultiArray, UbxRxmRawx, UbxRxmSfrbx,
 };
-use crate::ros::node::log_limit::LogLimiter;
 use crate::ros::outbound;
 
 use clock_check::ClockCheck;

@@ -15,13 +15,13 @@ pub mod params;
 use futures::stream::{self, LocalBoxStream, StreamExt};
 
 use crate::ros::args::NodeArgs;
+use crate::ros::log_limit::LogLimiter;
 use crate::ros::msg::{
     Clock, DiagnosticArray, GnssMeasurements, Header, Imu, Log, UInt8MultiArray, UbxRxmRawx,
     UbxRxmSfrbx,
 };
 use crate::ros::node::clock::NodeClock;
 use crate::ros::node::dds::{self, events, subscription, DdsOptions, Names, NodeError, Output};
-use crate::ros::node::log_limit::LogLimiter;
 use crate::ros::node::rosout::{self, LogLine, LogLines};
 use crate::ros::node::services::{ParamRequest, ParameterServices};
 use crate::ros::ubx_adapter::UbxAdapter;

@@ -12,7 +12,7 @@ use ros2_client::rcl_interfaces::{
 };
 
 use crate::config::ConfigError;
-use crate::ros::node::log_limit::LogLimiter;
+use crate::ros::log_limit::LogLimiter;
 use crate::ros::node::param_server::{
     bounded_names, fit, listed, oversized, parameter_value, result, value as empty_value,
     ParameterServer, MAX_NAMES,

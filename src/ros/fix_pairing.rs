@@ -1,7 +1,8 @@
 //! Pairs receiver fixes with the receiver velocities of the same stamp before the loose
 //! update, so the engine gets one fix with its velocity (it refuses a second measurement
-//! at one stamp). Pure logic over anything stamped: the live node pairs `gnss/fix` with
-//! `gnss/velocity` with it, and `gnss_ins replay` the same topics of a bag.
+//! at one stamp). Pure logic over anything stamped, used by
+//! [`FixVelocityJoin`](super::fix_velocity::FixVelocityJoin) to join `gnss/fix` with
+//! `gnss/velocity` in the adapter (the live node and `gnss_ins replay` alike).
 //!
 //! Choice (deterministic, driven by message order and stamps only, never by a clock; and
 //! the pairs do not depend on whether a fix or its velocity arrives first, since DDS gives
@@ -27,12 +28,6 @@
 pub trait Stamped {
     /// Its stamp (s).
     fn t_s(&self) -> f64;
-}
-
-impl Stamped for super::GnssFix {
-    fn t_s(&self) -> f64 {
-        self.t_s
-    }
 }
 
 /// A fix and a velocity belong together when their stamps differ by at most this (s).

@@ -1,0 +1,92 @@
+//! The adapter's /diagnostics report.
+
+use crate::ros::msg::{DiagnosticArray, DiagnosticStatus, Header, KeyValue, Time};
+
+use super::RosAdapter;
+
+impl RosAdapter {
+    /// The /diagnostics report at `stamp`: input counts, rejections by reason, phase and,
+    /// once running, the filter's 3D position sigma (level ERROR when it is not finite).
+    pub fn diagnostics(&self, node_name: &str, stamp: Time) -> DiagnosticArray {
+        let phase = match self.engine.init_phase() {
+            Some(p) => format!("initializing ({p:?})"),
+            None => "running".to_owned(),
+        };
+        let mut values = vec![
+            key_value("variant", self.engine.variant_name().to_owned()),
+            key_value("phase", phase.clone()),
+        ];
+        for (key, n) in self.counts.named() {
+            values.push(key_value(key, n.to_string()));
+            if key == "velocity_paired" {
+                let unpaired = self.unpaired_velocities().to_string();
+                values.push(key_value("unpaired_velocity", unpaired));
+            }
+        }
+        values.extend(self.engine.counters().iter().map(|(reason, n)| KeyValue {
+            key: format!("rejected_{}", reason.name()),
+            value: n.to_string(),
+        }));
+        let (level, message) = match self.engine.state() {
+            None => (DiagnosticStatus::WARN, phase),
+            Some(state) => {
+                let trace_m2 = state.solution().position_covariance_enu_m2().trace();
+                let sigma_m = position_sigma_3d_m(trace_m2);
+                values.push(key_value("position_sigma_3d_m", format!("{sigma_m:.3}")));
+                if sigma_m.is_finite() {
+                    (DiagnosticStatus::OK, phase)
+                } else {
+                    (
+                        DiagnosticStatus::ERROR,
+                        "filter covariance is not finite and positive".to_owned(),
+                    )
+                }
+            }
+        };
+        DiagnosticArray {
+            header: Header {
+                stamp,
+                frame_id: String::new(),
+            },
+            status: vec![DiagnosticStatus {
+                level,
+                name: format!("{node_name}: filter"),
+                message,
+                hardware_id: String::new(),
+                values,
+            }],
+        }
+    }
+}
+
+/// The 3D position sigma the filter claims, from the trace of its ENU position covariance:
+/// NaN when the trace is NaN, infinite or negative, so that a broken covariance reports
+/// ERROR instead of a sigma of zero (`NaN.max(0.0)` is 0).
+fn position_sigma_3d_m(trace_m2: f64) -> f64 {
+    if trace_m2 >= 0.0 && trace_m2.is_finite() {
+        trace_m2.sqrt()
+    } else {
+        f64::NAN
+    }
+}
+
+fn key_value(key: &str, value: String) -> KeyValue {
+    KeyValue {
+        key: key.to_owned(),
+        value,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::position_sigma_3d_m;
+
+    #[test]
+    fn a_broken_covariance_has_no_sigma() {
+        assert_eq!(position_sigma_3d_m(9.0), 3.0);
+        assert_eq!(position_sigma_3d_m(0.0), 0.0);
+        for trace in [f64::NAN, f64::INFINITY, -1e-6, f64::NEG_INFINITY] {
+            assert!(position_sigma_3d_m(trace).is_nan(), "trace {trace}");
+        }
+    }
+}

@@ -1,0 +1,210 @@
+//! Decoded input messages into the engine: conversion, frame locks, the time-jump rule and
+//! the fix / velocity join; what is dropped is counted and logged (rate-limited).
+
+use crate::engine::{GnssFix, Output, ResetReason};
+use crate::gnss::GnssEpoch;
+use crate::ins::ImuSample;
+use crate::ros::convert::GnssVelocity;
+use crate::ros::fix_velocity::{FramedFix, Joined, VelocityUse};
+use crate::ros::msg::{GnssMeasurements, Imu, NavSatFix, TwistWithCovarianceStamped};
+
+use super::{Input, Published, RosAdapter};
+
+/// Choice: an IMU stamp more than this much older than the last accepted one is a time
+/// jump (a bag played in a loop, or the samples after one stamped far ahead) and resets
+/// the filter; smaller steps back are ordinary out-of-order samples the engine rejects.
+/// 1 s is far beyond any transport reordering.
+pub const TIME_JUMP_BACK_S: f64 = 1.0;
+
+/// A decoded message on one of the adapter's input streams.
+#[derive(Debug, Clone, PartialEq)]
+pub enum InputMessage {
+    Imu(Imu),
+    Gnss(GnssMeasurements),
+    Fix(NavSatFix),
+    Velocity(TwistWithCovarianceStamped),
+}
+
+impl RosAdapter {
+    /// Handles one decoded message of any input stream.
+    pub fn on_message(&mut self, msg: &InputMessage) -> Vec<Published> {
+        match msg {
+            InputMessage::Imu(m) => self.on_imu(m),
+            InputMessage::Gnss(m) => self.on_gnss(m),
+            InputMessage::Fix(m) => self.on_fix(m),
+            InputMessage::Velocity(m) => self.on_velocity(m),
+        }
+    }
+
+    /// Records a payload on `topic` that did not decode.
+    pub fn on_undecodable(&mut self, topic: &str, error: &str) {
+        self.counts.undecodable += 1;
+        self.log.warn(
+            "undecodable",
+            &format!("undecodable message on {topic}: {error}"),
+        );
+    }
+
+    /// Handles one sensor_msgs/Imu.
+    pub fn on_imu(&mut self, msg: &Imu) -> Vec<Published> {
+        self.counts.imu_received += 1;
+        let sample = match ImuSample::try_from(msg) {
+            Ok(s) => s,
+            Err(e) => return self.unconvertible(Input::Imu, &e.to_string()),
+        };
+        if !self.imu_frame.admits(&msg.header.frame_id) {
+            return self.foreign_frame(Input::Imu, &msg.header.frame_id);
+        }
+        let mut outputs = Vec::new();
+        if let Some(last_t_s) = self.engine.last_imu_t_s() {
+            if sample.t_s < last_t_s - TIME_JUMP_BACK_S {
+                self.counts.time_jump_resets += 1;
+                log::warn!(
+                    "IMU time jumped back from {last_t_s:.3} s to {:.3} s: resetting the filter",
+                    sample.t_s
+                );
+                outputs.push(
+                    self.engine
+                        .reset(sample.t_s, ResetReason::TimeJumpBackwards),
+                );
+                self.pairing.clear();
+            }
+        }
+        let released = self.pairing.on_time(sample.t_s);
+        self.push_fixes(released, &mut outputs);
+        match self.engine.push_imu(&sample) {
+            Ok(o) => {
+                self.imu_frame.accepted(&msg.header.frame_id);
+                if outputs.is_empty() {
+                    outputs = o;
+                } else {
+                    outputs.extend(o);
+                }
+            }
+            Err(e) => {
+                self.log.warn(e.reason.name(), &format!("imu: {e}"));
+            }
+        }
+        self.publishable(outputs)
+    }
+
+    /// Handles one GnssMeasurements (tight coupling).
+    pub fn on_gnss(&mut self, msg: &GnssMeasurements) -> Vec<Published> {
+        self.counts.gnss_received += 1;
+        let epoch = match GnssEpoch::try_from(msg) {
+            Ok(e) => e,
+            Err(e) => return self.unconvertible(Input::Gnss, &e.to_string()),
+        };
+        if !self.gnss_frame.admits(&msg.header.frame_id) {
+            return self.foreign_frame(Input::Gnss, &msg.header.frame_id);
+        }
+        let outputs = match self.engine.push_gnss(epoch) {
+            Ok(o) => {
+                self.gnss_frame.accepted(&msg.header.frame_id);
+                o
+            }
+            Err(e) => {
+                self.log.warn(e.reason.name(), &format!("gnss: {e}"));
+                Vec::new()
+            }
+        };
+        self.publishable(outputs)
+    }
+
+    /// Handles one NavSatFix (loose coupling); a fix without a solution is counted and
+    /// dropped.
+    pub fn on_fix(&mut self, msg: &NavSatFix) -> Vec<Published> {
+        self.counts.fix_received += 1;
+        let fix = match GnssFix::try_from(msg) {
+            Ok(f) => f,
+            Err(e) => return self.unconvertible(Input::Fix, &e.to_string()),
+        };
+        if !self.fix_frame.admits(&msg.header.frame_id) {
+            return self.foreign_frame(Input::Fix, &msg.header.frame_id);
+        }
+        let released = self.pairing.on_fix(FramedFix {
+            fix,
+            frame_id: msg.header.frame_id.clone(),
+        });
+        self.publish_fixes(released)
+    }
+
+    /// Handles one velocity on `gnss/velocity` (loose coupling): it joins the fix of its
+    /// stamp (see [`crate::ros::fix_pairing`] and
+    /// [`FixVelocityJoin`](crate::ros::fix_velocity::FixVelocityJoin): in the map frame or
+    /// the fix's frame). Any other frame is counted and the fix goes on without it.
+    pub fn on_velocity(&mut self, msg: &TwistWithCovarianceStamped) -> Vec<Published> {
+        self.counts.velocity_received += 1;
+        let velocity = match GnssVelocity::try_from(msg) {
+            Ok(v) => v,
+            Err(e) => return self.unconvertible(Input::Velocity, &e.to_string()),
+        };
+        let released = self.pairing.on_velocity(velocity);
+        self.publish_fixes(released)
+    }
+
+    /// Feeds joined fixes; what the engine returned, to publish.
+    fn publish_fixes(&mut self, joined: Vec<Joined>) -> Vec<Published> {
+        let mut outputs = Vec::new();
+        self.push_fixes(joined, &mut outputs);
+        self.publishable(outputs)
+    }
+
+    /// Feeds joined fixes into `outputs`, counting what became of their velocities.
+    fn push_fixes(&mut self, joined: Vec<Joined>, outputs: &mut Vec<Output>) {
+        for Joined {
+            fix,
+            frame_id,
+            velocity,
+        } in joined
+        {
+            match velocity {
+                VelocityUse::None => {}
+                VelocityUse::Paired => self.counts.velocity_paired += 1,
+                VelocityUse::ForeignFrame(v_frame) => {
+                    self.foreign_frame(Input::Velocity, &v_frame);
+                }
+            }
+            match self.engine.push_fix(fix) {
+                Ok(o) => {
+                    self.fix_frame.accepted(&frame_id);
+                    outputs.extend(o);
+                }
+                Err(e) => {
+                    self.log.warn(e.reason.name(), &format!("fix: {e}"));
+                }
+            }
+        }
+    }
+
+    /// Counts and logs a message of `input` that did not convert.
+    fn unconvertible(&mut self, input: Input, error: &str) -> Vec<Published> {
+        *self.counts.unconvertible(input) += 1;
+        let name = input.name();
+        self.log.warn(
+            &format!("unconvertible {name}"),
+            &format!("dropped a message on {name}: {error}"),
+        );
+        Vec::new()
+    }
+
+    /// Counts and logs a message of `input` from another frame than the one it follows.
+    fn foreign_frame(&mut self, input: Input, frame_id: &str) -> Vec<Published> {
+        let expected = match input {
+            Input::Imu => format!("`{}`", self.imu_frame.locked()),
+            Input::Gnss => format!("`{}`", self.gnss_frame.locked()),
+            Input::Fix => format!("`{}`", self.fix_frame.locked()),
+            Input::Velocity => format!(
+                "`{}` (ENU) or its fix's frame",
+                self.outputs.frames().map_frame
+            ),
+        };
+        *self.counts.foreign_frame(input) += 1;
+        let name = input.name();
+        self.log.warn(
+            &format!("foreign frame {name}"),
+            &format!("dropped a message on {name} from frame `{frame_id}`: the node follows {expected} (a second publisher?)"),
+        );
+        Vec::new()
+    }
+}

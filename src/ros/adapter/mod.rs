@@ -1,0 +1,100 @@
+//! The ROS adapter: decoded ROS messages in, ROS messages to publish out, around the one
+//! [`Engine`]. No DDS, no clock, no file: the live node ([`crate::ros::node`]) drives it
+//! from its subscriptions and `gnss_ins replay` from a bag's messages, so both convert,
+//! lock frames, join fixes with velocities, reset on time jumps, drop non-finite outputs
+//! and count what they drop by the same code.
+//!
+//! Data flow of one IMU sample: `sensor_msgs/Imu` → [`RosAdapter::on_imu`] (conversion
+//! [`ImuSample::try_from`](crate::ins::ImuSample), frame lock, time-jump rule, the fixes
+//! the join releases at this IMU time) → [`Engine::push_imu`] (mechanization and
+//! covariance propagation, a [`Solution`](crate::engine::Solution) per sample or at
+//! `output.rate_hz`) → `outputs` (the guard: every number finite, no negative variance;
+//! then Odometry, NavSatFix and, with `publish_tf`, the TF) → [`Published::Solution`],
+//! which keeps the solution for `replay`'s CSV and scoring.
+//!
+//! Data flow of one GNSS epoch: `GnssMeasurements` → [`RosAdapter::on_gnss`] (conversion
+//! [`GnssEpoch::try_from`](crate::gnss::GnssEpoch), frame lock) → [`Engine::push_gnss`]
+//! (held until the IMU passes its stamp, then the tight update, or a roll-back when late)
+//! → [`Published::Epoch`] with its NoiseEstimates; the solutions after it follow with the
+//! next IMU samples. A `NavSatFix` ([`RosAdapter::on_fix`]) first waits in the fix /
+//! velocity join for the `gnss/velocity` of its stamp, then goes to [`Engine::push_fix`].
+//!
+//! Adding an input message: its conversion in [`crate::ros::convert`], one handler method
+//! in `inputs.rs` (and its [`InputMessage`] variant and [`Input`] counters); then the
+//! node's subscription and the bag topic of `gnss_ins replay`.
+
+mod counts;
+mod diagnostics;
+mod frame_lock;
+mod guard;
+mod inputs;
+mod outputs;
+#[cfg(test)]
+mod tests;
+
+use crate::config::Config;
+use crate::engine::{Engine, NotRuntimeTunable};
+use crate::ros::fix_velocity::FixVelocityJoin;
+
+use crate::ros::log_limit::LogLimiter;
+pub use counts::{Input, InputCounts};
+use frame_lock::FrameLock;
+pub use inputs::{InputMessage, TIME_JUMP_BACK_S};
+pub use outputs::{OutputFrames, Published, PublishedEpoch, PublishedSolution, SolutionMessages};
+
+/// The engine with the node's message handling; see the module documentation.
+pub struct RosAdapter {
+    engine: Engine,
+    counts: InputCounts,
+    log: LogLimiter,
+    imu_frame: FrameLock,
+    gnss_frame: FrameLock,
+    fix_frame: FrameLock,
+    pairing: FixVelocityJoin,
+    outputs: outputs::Framing,
+}
+
+impl RosAdapter {
+    /// An adapter running `config`, publishing in `frames`.
+    pub fn new(config: Config, frames: OutputFrames) -> Self {
+        Self {
+            pairing: FixVelocityJoin::new(&frames.map_frame),
+            outputs: outputs::Framing::new(frames, config.output.datum),
+            engine: Engine::new(config),
+            counts: InputCounts::default(),
+            log: LogLimiter::default(),
+            imu_frame: FrameLock::default(),
+            gnss_frame: FrameLock::default(),
+            fix_frame: FrameLock::default(),
+        }
+    }
+
+    /// The adapter for a run that publishes nothing (`gnss_ins replay` without an output
+    /// bag, `compare`): solutions are judged and handed out as before, but not framed
+    /// into messages, which would cost a run of the filter about a sixth more.
+    pub fn without_messages(mut self) -> Self {
+        self.outputs.without_messages();
+        self
+    }
+
+    /// The input counters.
+    pub fn counts(&self) -> &InputCounts {
+        &self.counts
+    }
+
+    /// The engine (for its counters and phase).
+    pub fn engine(&self) -> &Engine {
+        &self.engine
+    }
+
+    /// Takes over a configuration that differs only in runtime parameters (see
+    /// [`Engine::retune`]); the filter keeps running.
+    pub fn retune(&mut self, config: Config) -> Result<(), NotRuntimeTunable> {
+        self.engine.retune(config)
+    }
+
+    /// Velocities dropped for want of a fix of their stamp.
+    pub fn unpaired_velocities(&self) -> u64 {
+        self.pairing.unpaired_velocities()
+    }
+}

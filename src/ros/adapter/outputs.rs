@@ -1,0 +1,191 @@
+//! Engine outputs into the messages to publish: framing (datum, frames, stamps) and the
+//! TF, behind the guard ([`super::guard`]); status events are logged.
+
+use crate::earth::Llh;
+use crate::engine::{EpochReport, Output, Solution, StatusEvent};
+use crate::ros::convert::seconds_to_time;
+use crate::ros::msg::{NavSatFix, NoiseEstimates, Odometry, TFMessage};
+use crate::ros::outbound;
+
+use super::guard::{self, Unpublishable};
+use super::RosAdapter;
+
+/// The frames of the published messages and whether the TF is published.
+///
+/// Choice: fixed at start (read-only through the parameter services): a TF tree whose
+/// frames change while it runs would break its listeners.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct OutputFrames {
+    /// Parent frame of Odometry and TF (default `map`).
+    pub map_frame: String,
+    /// Child frame of Odometry and TF, frame of NavSatFix (default `base_link`).
+    pub base_frame: String,
+    /// Publish the TF `map_frame` → `base_frame` (default false).
+    pub publish_tf: bool,
+}
+
+impl Default for OutputFrames {
+    fn default() -> Self {
+        Self {
+            map_frame: "map".to_owned(),
+            base_frame: "base_link".to_owned(),
+            publish_tf: false,
+        }
+    }
+}
+
+/// What one engine output became: the messages to publish, each with the output it came
+/// from (what `gnss_ins replay` scores and writes to its CSV), so nothing is converted
+/// twice and nothing unpublished is scored.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Published {
+    /// A solution, on `odometry`, `fix` and (with `publish_tf`) `/tf`.
+    Solution(PublishedSolution),
+    /// An epoch's report, on `~/noise_estimates`.
+    Epoch(Box<PublishedEpoch>),
+}
+
+/// An epoch's report and its message.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PublishedEpoch {
+    /// The engine's report.
+    pub report: EpochReport,
+    /// Its message.
+    pub noise: NoiseEstimates,
+}
+
+/// A solution (every number finite, every variance non-negative) and its messages.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PublishedSolution {
+    /// The engine's solution.
+    pub solution: Box<Solution>,
+    /// Its messages; None from an adapter that frames none (see
+    /// [`RosAdapter::without_messages`]).
+    pub messages: Option<Box<SolutionMessages>>,
+}
+
+/// The messages of one solution.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SolutionMessages {
+    /// Pose in `map_frame` (ENU at the datum), twist in `base_frame`.
+    pub odometry: Odometry,
+    /// The body position, in `base_frame`.
+    pub fix: NavSatFix,
+    /// `map_frame` → `base_frame` (only with `publish_tf`).
+    pub tf: Option<TFMessage>,
+}
+
+/// The output frames and the datum of the Odometry.
+#[derive(Debug, Clone)]
+pub(super) struct Framing {
+    frames: OutputFrames,
+    /// The configured datum, else the first solution's position.
+    datum: Option<Llh>,
+    /// Whether solutions are framed into messages.
+    messages: bool,
+}
+
+impl Framing {
+    pub(super) fn new(frames: OutputFrames, datum: Option<Llh>) -> Self {
+        Self {
+            frames,
+            datum,
+            messages: true,
+        }
+    }
+
+    pub(super) fn frames(&self) -> &OutputFrames {
+        &self.frames
+    }
+
+    pub(super) fn without_messages(&mut self) {
+        self.messages = false;
+    }
+
+    /// `solution` with its messages, unless a number of it or of its messages is not
+    /// finite (or its time has no ROS stamp), or a variance is negative.
+    ///
+    /// The solution itself is judged first, so an adapter that frames no messages drops
+    /// the same solutions, except what only framing shows: the messages are checked
+    /// again for an overflow or for a negative variance of the twist's rotated velocity
+    /// covariance (a velocity block that is no covariance any more: a diverged filter;
+    /// 10 of 1979 dropped solutions in the replay test of issue 12, item 7).
+    fn solution(&mut self, solution: Box<Solution>) -> Result<PublishedSolution, Unpublishable> {
+        guard::judge(&solution)?;
+        let messages = if self.messages {
+            Some(Box::new(self.messages_of(&solution)?))
+        } else {
+            None
+        };
+        Ok(PublishedSolution { solution, messages })
+    }
+
+    fn messages_of(&mut self, solution: &Solution) -> Result<SolutionMessages, Unpublishable> {
+        let stamp = seconds_to_time(solution.nav.t_s).map_err(|_| Unpublishable::NonFinite)?;
+        let datum = *self.datum.get_or_insert(solution.nav.p);
+        let f = &self.frames;
+        let odometry = outbound::odometry(solution, &datum, stamp, &f.map_frame, &f.base_frame);
+        let fix = outbound::nav_sat_fix(solution, stamp, &f.base_frame);
+        guard::judge_messages(&odometry, &fix)?;
+        Ok(SolutionMessages {
+            tf: f.publish_tf.then(|| outbound::transform(&odometry)),
+            odometry,
+            fix,
+        })
+    }
+}
+
+impl RosAdapter {
+    /// The messages of the engine's `outputs`; solutions the guard refuses are counted and
+    /// dropped.
+    pub(super) fn publishable(&mut self, outputs: Vec<Output>) -> Vec<Published> {
+        let mut published = Vec::with_capacity(outputs.len());
+        for output in outputs {
+            match output {
+                Output::Solution(solution) => match self.outputs.solution(solution) {
+                    Ok(s) => published.push(Published::Solution(s)),
+                    Err(Unpublishable::NonFinite) => {
+                        self.counts.non_finite_outputs += 1;
+                        self.log.warn(
+                            "non_finite_output",
+                            "solution with a non-finite value dropped",
+                        );
+                    }
+                    Err(Unpublishable::NegativeVariance) => {
+                        self.counts.negative_variance_outputs += 1;
+                        self.log.warn(
+                            "negative_variance_output",
+                            "solution with a negative variance dropped",
+                        );
+                    }
+                },
+                Output::Epoch(report) => {
+                    if let Ok(stamp) = seconds_to_time(report.t_s) {
+                        let noise = outbound::noise_estimates(
+                            &report,
+                            stamp,
+                            &self.outputs.frames.base_frame,
+                        );
+                        published
+                            .push(Published::Epoch(Box::new(PublishedEpoch { report, noise })));
+                    }
+                }
+                Output::Status(StatusEvent::Initialized {
+                    t_s,
+                    heading_from_motion,
+                }) => log::info!(
+                    "filter initialized at {t_s:.3} s (heading from {})",
+                    if heading_from_motion {
+                        "motion"
+                    } else {
+                        "the configuration"
+                    }
+                ),
+                Output::Status(StatusEvent::Reset { t_s, reason }) => {
+                    log::warn!("filter reset at {t_s:.3} s: {reason:?}")
+                }
+            }
+        }
+        published
+    }
+}

@@ -1,0 +1,331 @@
+//! The adapter's message handling, driven as the node and replay drive it.
+
+use nalgebra::Matrix3;
+
+use super::*;
+use crate::engine::RejectionReason;
+use crate::ins::ImuSample;
+use crate::ros::convert::seconds_to_time;
+use crate::ros::msg::{Imu, NavSatFix, Time, TwistWithCovarianceStamped};
+use crate::ros::outbound;
+
+fn imu_at(t_s: f64) -> Imu {
+    let sample = ImuSample {
+        t_s,
+        w_ib_b_rad_s: nalgebra::Vector3::zeros(),
+        f_ib_b_m_s2: nalgebra::Vector3::new(0.0, 0.0, 9.8),
+    };
+    outbound::imu(&sample, seconds_to_time(t_s).unwrap(), "imu")
+}
+
+/// The messages of a published solution.
+fn messages(published: &Published) -> Option<&SolutionMessages> {
+    match published {
+        Published::Solution(s) => s.messages.as_deref(),
+        Published::Epoch(_) => None,
+    }
+}
+
+fn feed(adapter: &mut RosAdapter, t0_s: f64, t1_s: f64) {
+    let n = ((t1_s - t0_s) * 100.0).round() as usize;
+    for k in 0..n {
+        adapter.on_imu(&imu_at(t0_s + k as f64 * 0.01));
+    }
+}
+
+fn diagnostic(adapter: &RosAdapter, key: &str) -> Option<String> {
+    let d = adapter.diagnostics("/n", Time::default());
+    d.status[0]
+        .values
+        .iter()
+        .find(|kv| kv.key == key)
+        .map(|kv| kv.value.clone())
+}
+
+#[test]
+fn time_jump_backwards_resets_small_steps_are_rejected() {
+    let mut adapter = RosAdapter::new(Config::default(), OutputFrames::default());
+    feed(&mut adapter, 100.0, 102.0);
+    adapter.on_imu(&imu_at(101.5));
+    assert_eq!(adapter.counts().time_jump_resets, 0);
+    assert_eq!(
+        adapter
+            .engine()
+            .counters()
+            .count(RejectionReason::ImuOutOfOrder),
+        1
+    );
+    feed(&mut adapter, 50.0, 51.0);
+    assert_eq!(adapter.counts().time_jump_resets, 1);
+    assert_eq!(adapter.engine().last_imu_t_s(), Some(50.99));
+    assert_eq!(
+        adapter
+            .engine()
+            .counters()
+            .count(RejectionReason::ImuOutOfOrder),
+        1,
+        "the samples after the jump are accepted"
+    );
+    assert_eq!(
+        diagnostic(&adapter, "time_jump_resets").as_deref(),
+        Some("1")
+    );
+    assert_eq!(diagnostic(&adapter, "imu_received").as_deref(), Some("301"));
+}
+
+#[test]
+fn bad_inputs_are_counted_and_dropped() {
+    let mut adapter = RosAdapter::new(Config::default(), OutputFrames::default());
+    feed(&mut adapter, 10.0, 10.5);
+    let mut nan = imu_at(10.5);
+    nan.linear_acceleration.y = f64::NAN;
+    assert!(adapter.on_imu(&nan).is_empty());
+    let mut bad_stamp = imu_at(10.6);
+    bad_stamp.header.stamp.nanosec = 1_500_000_000;
+    assert!(adapter.on_imu(&bad_stamp).is_empty());
+    adapter.on_undecodable("imu", "truncated payload");
+    let mut no_fix = NavSatFix::default();
+    no_fix.status.status = -1;
+    assert!(adapter.on_fix(&no_fix).is_empty());
+    assert_eq!(adapter.counts().unconvertible_imu, 2, "NaN and a bad stamp");
+    assert_eq!(adapter.counts().unconvertible_fix, 1);
+    assert_eq!(adapter.counts().undecodable, 1);
+    assert_eq!(
+        diagnostic(&adapter, "unconvertible_imu").as_deref(),
+        Some("2")
+    );
+    assert_eq!(
+        diagnostic(&adapter, "phase").as_deref(),
+        Some("initializing (Leveling)")
+    );
+    // The node goes on with good data.
+    feed(&mut adapter, 10.7, 11.0);
+    assert_eq!(adapter.engine().last_imu_t_s(), Some(10.99));
+}
+
+#[test]
+fn a_second_imu_frame_is_counted_and_dropped() {
+    let mut adapter = RosAdapter::new(Config::default(), OutputFrames::default());
+    feed(&mut adapter, 10.0, 10.5);
+    let mut other = imu_at(10.505);
+    other.header.frame_id = "other_imu".to_owned();
+    assert!(adapter.on_imu(&other).is_empty());
+    assert_eq!(adapter.counts().foreign_frame_imu, 1);
+    assert_eq!(
+        adapter.engine().last_imu_t_s(),
+        Some(10.49),
+        "not fed to the engine"
+    );
+    assert_eq!(
+        diagnostic(&adapter, "foreign_frame_imu").as_deref(),
+        Some("1")
+    );
+    feed(&mut adapter, 10.5, 10.6);
+    assert_eq!(
+        adapter.engine().last_imu_t_s(),
+        Some(10.59),
+        "the first frame goes on"
+    );
+}
+
+#[test]
+fn loose_coupling_runs_on_fixes_and_counts_raw_epochs_as_wrong_coupling() {
+    use crate::sim::SimEvent;
+    let mut adapter = loose_adapter(OutputFrames::default());
+    let (mut odometry, mut epochs) = (0, 0);
+    let mut out_had_tf = false;
+    for_each_static_event_30_s(|event, stamp| {
+        let out = match event {
+            SimEvent::Imu(s) => adapter.on_imu(&outbound::imu(&s, stamp, "imu")),
+            SimEvent::Fix(f) => adapter.on_fix(&outbound::receiver_fix(&f, stamp, "gnss")),
+            SimEvent::Gnss { epoch, .. } => {
+                epochs += 1;
+                adapter.on_gnss(&outbound::gnss_measurements(&epoch, 0, stamp, "gnss"))
+            }
+            _ => Vec::new(),
+        };
+        odometry += out
+            .iter()
+            .filter(|m| matches!(m, Published::Solution(_)))
+            .count();
+        out_had_tf |= out
+            .iter()
+            .any(|m| messages(m).is_some_and(|m| m.tf.is_some()));
+    });
+    assert!(odometry > 2000, "{odometry} odometry messages in 30 s");
+    assert_eq!(adapter.counts().velocity_received, 0);
+    assert!(!out_had_tf, "no /tf without publish_tf");
+    assert_eq!(adapter.engine().init_phase(), None, "running");
+    assert_eq!(adapter.counts().unconvertible_fix, 0);
+    assert_eq!(
+        adapter
+            .engine()
+            .counters()
+            .count(RejectionReason::WrongCoupling),
+        epochs
+    );
+}
+
+fn loose_adapter(frames: OutputFrames) -> RosAdapter {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/params/ekf_loose.yaml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut config = Config::from_yaml_str(&text, path).unwrap();
+    // The static scenario faces north; heading is not observable at rest.
+    config.set_parameter("init.heading_deg", "0.0").unwrap();
+    RosAdapter::new(config, frames)
+}
+
+/// Calls `on_event` with the static scenario's events of its first 30 s, each with its
+/// stamp.
+fn for_each_static_event_30_s(mut on_event: impl FnMut(crate::sim::SimEvent, Time)) {
+    let scenario = crate::sim::Scenario::builtin("static", 5).unwrap();
+    for event in scenario.events() {
+        let event = event.unwrap();
+        if event.t_s() > 30.0 {
+            break;
+        }
+        let stamp = seconds_to_time(event.t_s()).unwrap();
+        on_event(event, stamp);
+    }
+}
+
+/// The velocity message of a simulated fix (ENU twist, the linear covariance block).
+fn velocity_of(fix: &crate::engine::GnssFix, frame_id: &str) -> TwistWithCovarianceStamped {
+    let stamp = seconds_to_time(fix.t_s).unwrap();
+    outbound::receiver_velocity(fix, stamp, frame_id).unwrap()
+}
+
+#[test]
+fn velocities_pair_with_their_fixes_bad_ones_are_counted_and_tf_follows_odometry() {
+    use crate::sim::SimEvent;
+    let frames = OutputFrames {
+        map_frame: "map".to_owned(),
+        base_frame: "imu_link".to_owned(),
+        publish_tf: true,
+    };
+    let mut adapter = loose_adapter(frames);
+    let mut out = Vec::new();
+    let (mut fixes, mut paired) = (0, 0);
+    for_each_static_event_30_s(|event, stamp| {
+        match event {
+            SimEvent::Imu(s) => out.extend(adapter.on_imu(&outbound::imu(&s, stamp, "imu"))),
+            SimEvent::Fix(f) => {
+                fixes += 1;
+                let fix = outbound::receiver_fix(&f, stamp, "gnss");
+                // Velocity in the map frame or in the fix's frame, after or before
+                // (after for the first: it pairs as well).
+                let mut velocity = velocity_of(&f, ["map", "gnss"][fixes % 2]);
+                match fixes {
+                    3 => velocity.twist.twist.linear.x = f64::NAN,
+                    5 => velocity.header.frame_id = "base_link".to_owned(),
+                    _ => paired += 1,
+                }
+                if fixes % 2 == 0 {
+                    out.extend(adapter.on_velocity(&velocity));
+                    out.extend(adapter.on_fix(&fix));
+                } else {
+                    out.extend(adapter.on_fix(&fix));
+                    out.extend(adapter.on_velocity(&velocity));
+                }
+                if fixes == 7 {
+                    // A velocity whose fix never comes, and one repeated after its fix.
+                    let mut late = velocity.clone();
+                    late.header.stamp = seconds_to_time(f.t_s + 0.5).unwrap();
+                    out.extend(adapter.on_velocity(&velocity));
+                    out.extend(adapter.on_velocity(&late));
+                }
+            }
+            _ => {}
+        }
+    });
+    let c = adapter.counts();
+    assert!(fixes > 25, "{fixes} fixes");
+    assert_eq!(c.velocity_received, fixes as u64 + 2);
+    assert_eq!(c.velocity_paired, paired);
+    assert_eq!(c.unconvertible_velocity, 1, "NaN");
+    assert_eq!(c.foreign_frame_velocity, 1);
+    assert_eq!(adapter.unpaired_velocities(), 2, "repeated and fix-less");
+    assert_eq!(
+        diagnostic(&adapter, "unpaired_velocity").as_deref(),
+        Some("2")
+    );
+    assert_eq!(
+        diagnostic(&adapter, "velocity_paired"),
+        Some(paired.to_string())
+    );
+    let counters = adapter.engine().counters();
+    for reason in [
+        RejectionReason::MeasurementDuplicate,
+        RejectionReason::FixNotFinite,
+        RejectionReason::MeasurementTooOld,
+    ] {
+        assert_eq!(counters.count(reason), 0, "{reason:?}");
+    }
+    assert_eq!(adapter.engine().init_phase(), None, "running");
+    // Every Odometry comes with its TF: same stamp, frames, translation and rotation.
+    let mut tf_count = 0;
+    for m in &out {
+        if let Some(SolutionMessages {
+            odometry: o,
+            tf: Some(tf),
+            ..
+        }) = messages(m)
+        {
+            tf_count += 1;
+            let t = &tf.transforms[0];
+            assert_eq!(t.header, o.header);
+            assert_eq!(
+                (t.header.frame_id.as_str(), t.child_frame_id.as_str()),
+                ("map", "imu_link")
+            );
+            let p = &o.pose.pose.position;
+            let tr = &t.transform.translation;
+            assert_eq!([tr.x, tr.y, tr.z], [p.x, p.y, p.z]);
+            assert_eq!(t.transform.rotation, o.pose.pose.orientation);
+        }
+    }
+    let odometry = out
+        .iter()
+        .filter(|m| matches!(m, Published::Solution(_)))
+        .count();
+    assert!(
+        odometry > 2000 && tf_count == odometry,
+        "{tf_count} TF, {odometry} odometry"
+    );
+}
+
+#[test]
+fn a_paired_velocity_reaches_the_filter() {
+    use crate::sim::SimEvent;
+    // The receiver at rest claims 1 m/s east with σ 0.05 m/s: the filter must follow it.
+    let speed_after = |bias_mps: f64| {
+        let mut adapter = loose_adapter(OutputFrames::default());
+        let mut last = None;
+        for_each_static_event_30_s(|event, stamp| {
+            let out = match event {
+                SimEvent::Imu(s) => adapter.on_imu(&outbound::imu(&s, stamp, "imu")),
+                SimEvent::Fix(mut f) => {
+                    let mut out = adapter.on_fix(&outbound::receiver_fix(&f, stamp, "gnss"));
+                    f.velocity_enu_mps = Some(nalgebra::Vector3::new(bias_mps, 0.0, 0.0));
+                    f.velocity_covariance_enu_m2_s2 = Some(Matrix3::identity() * 0.05f64.powi(2));
+                    out.extend(adapter.on_velocity(&velocity_of(&f, "map")));
+                    out
+                }
+                _ => Vec::new(),
+            };
+            for m in out {
+                if let Some(s) = messages(&m) {
+                    let v = &s.odometry.twist.twist.linear;
+                    last = Some(nalgebra::Vector3::new(v.x, v.y, v.z).norm());
+                }
+            }
+        });
+        assert!(adapter.counts().velocity_paired > 25);
+        last.unwrap()
+    };
+    let honest = speed_after(0.0);
+    let biased = speed_after(1.0);
+    eprintln!("speed after 30 s: {honest:.3} m/s at rest, {biased:.3} m/s with the 1 m/s claim");
+    assert!(honest < 0.1, "at rest: {honest} m/s");
+    assert!(biased > 0.5, "following the claimed 1 m/s: {biased} m/s");
+}
