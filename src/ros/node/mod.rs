@@ -11,6 +11,7 @@
 
 pub mod clock;
 pub mod dds;
+pub mod housekeeping;
 pub mod input_stats;
 pub mod param_server;
 pub mod params;
@@ -143,10 +144,10 @@ pub fn run(
         events(&velocity_sub, Event::Velocity),
         events(&clock_sub, Event::Clock),
     ];
-    sources.extend(dds::housekeeping(
+    sources.extend(housekeeping::housekeeping(
         &services,
         log_lines,
-        dds::Housekeeping {
+        housekeeping::Housekeeping {
             tick: || Event::Tick,
             param: Event::Param,
             log_line: Event::LogLine,

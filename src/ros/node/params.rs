@@ -171,11 +171,11 @@ impl NodeParameter {
     }
 }
 
-/// `docs/parameters.md`: the core's parameters, the node's, and those of
-/// `gnss_ins_ubx_node`.
+/// `docs/parameters.md` up to `gnss_ins_ubx_node`'s section: the core's parameters and
+/// the node's.
 pub fn reference() -> String {
     let rows: Vec<Row> = NODE_PARAMETERS.iter().map(NodeParameter::row).collect();
-    crate::config::manual::reference(&rows) + &crate::ros::ubx_node::params::reference_section()
+    crate::config::manual::reference(&rows)
 }
 
 /// What the command line configures: the core's configuration and the node's own

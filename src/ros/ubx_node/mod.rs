@@ -22,6 +22,7 @@ use crate::ros::msg::{
 };
 use crate::ros::node::clock::NodeClock;
 use crate::ros::node::dds::{self, events, subscription, DdsOptions, Names, NodeError, Output};
+use crate::ros::node::housekeeping;
 use crate::ros::node::rosout::{self, LogLine, LogLines};
 use crate::ros::node::services::{ParamRequest, ParameterServices};
 use crate::ros::ubx_adapter::UbxAdapter;
@@ -108,10 +109,10 @@ pub fn run(
         events(&imu_sub, |r| Event::Imu(r.map(Box::new))),
         events(&clock_sub, Event::Clock),
     ];
-    sources.extend(dds::housekeeping(
+    sources.extend(housekeeping::housekeeping(
         &services,
         log_lines,
-        dds::Housekeeping {
+        housekeeping::Housekeeping {
             tick: || Event::Tick,
             param: Event::Param,
             log_line: Event::LogLine,
