@@ -162,7 +162,7 @@ fn yaml_text(new: &ParameterValue, current_type: u8) -> Result<String, String> {
     serde_yaml::to_string(&yaml).map_err(|e| e.to_string())
 }
 
-pub fn type_name(ptype: u8) -> &'static str {
+fn type_name(ptype: u8) -> &'static str {
     match ptype {
         ParameterType::BOOL => "bool",
         ParameterType::INTEGER => "integer",

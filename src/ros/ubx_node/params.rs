@@ -202,11 +202,11 @@ impl UbxNodeParams {
         vec![
             (USE_SIM_TIME, self.use_sim_time.into()),
             (QUEUE_DEPTH, self.queue_depth.into()),
-            (TIME_BASE, time_base_name(a.time_base).into()),
+            (TIME_BASE, name_of(&TIME_BASES, &a.time_base).into()),
             (LEAP_SECONDS, a.leap_seconds.into()),
             (HOST_LATENCY_S, a.host_latency_s.into()),
             (MAX_IMU_GNSS_SKEW_S, a.max_imu_gnss_skew_s.into()),
-            (IONOSPHERE, ionosphere_name(a.ionosphere).into()),
+            (IONOSPHERE, name_of(&IONOSPHERES, &a.ionosphere).into()),
             (FRAME_ID, a.frame_id.clone().into()),
             (OFFSET_WINDOW_EPOCHS, a.offset_window_epochs.into()),
             (RAWX_TOPIC, t.rawx.clone().into()),
@@ -218,19 +218,21 @@ impl UbxNodeParams {
     }
 }
 
-fn time_base_name(t: TimeBase) -> &'static str {
-    match t {
-        TimeBase::Gnss => "gnss",
-        TimeBase::Host => "host",
-    }
-}
+/// The values of `time_base` by name.
+const TIME_BASES: [(&str, TimeBase); 2] = [("gnss", TimeBase::Gnss), ("host", TimeBase::Host)];
+/// The values of `ionosphere` by name.
+const IONOSPHERES: [(&str, IonosphereMode); 3] = [
+    ("iono_free", IonosphereMode::IonoFree),
+    ("broadcast", IonosphereMode::Broadcast),
+    ("none", IonosphereMode::None),
+];
 
-fn ionosphere_name(m: IonosphereMode) -> &'static str {
-    match m {
-        IonosphereMode::IonoFree => "iono_free",
-        IonosphereMode::Broadcast => "broadcast",
-        IonosphereMode::None => "none",
-    }
+/// The name of `value` among `choices`.
+fn name_of<T: PartialEq>(choices: &[(&'static str, T)], value: &T) -> &'static str {
+    choices
+        .iter()
+        .find(|(_, v)| v == value)
+        .map_or("", |(n, _)| n)
 }
 
 /// One of `choices` by its name, or `default`.
@@ -296,7 +298,7 @@ pub fn ubx_node_params_from(values: &[Assignment]) -> Result<UbxNodeParams, UbxP
         time_base: one_of(
             value(TIME_BASE),
             TIME_BASE,
-            &[("gnss", TimeBase::Gnss), ("host", TimeBase::Host)],
+            &TIME_BASES,
             "must be gnss or host",
             d.time_base,
         )?,
@@ -324,11 +326,7 @@ pub fn ubx_node_params_from(values: &[Assignment]) -> Result<UbxNodeParams, UbxP
         ionosphere: one_of(
             value(IONOSPHERE),
             IONOSPHERE,
-            &[
-                ("iono_free", IonosphereMode::IonoFree),
-                ("broadcast", IonosphereMode::Broadcast),
-                ("none", IonosphereMode::None),
-            ],
+            &IONOSPHERES,
             "must be iono_free, broadcast or none",
             d.ionosphere,
         )?,
