@@ -9,16 +9,29 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use adaptive_gnss_ins::config::{Config, Coupling};
-use adaptive_gnss_ins::ros::args::parse;
+use adaptive_gnss_ins::ros::args::{parse, parse_as, NodeArgs};
+use adaptive_gnss_ins::ros::names::resolve_remapped;
 use adaptive_gnss_ins::ros::node::params::{
-    config_from_files, load, NodeParams, NODE_PARAMETERS, USE_SIM_TIME,
+    config_from_files, load, NodeParams, NODE_PARAMETERS, QUEUE_DEPTH, USE_SIM_TIME,
 };
+use adaptive_gnss_ins::ros::ubx_adapter::TimeBase;
+use adaptive_gnss_ins::ros::ubx_node::{self, params::UBX_NODE_PARAMETERS};
 
 mod venv_support;
 
 /// The names of the node's own parameters.
 fn node_parameter_names() -> Vec<&'static str> {
     NODE_PARAMETERS.iter().map(|p| p.name).collect()
+}
+
+/// The parameters of gnss_ins_ubx_node the launch file declares: its table but the topic
+/// names (remapped instead) and those shared with gnss_ins_node.
+fn ubx_launch_parameter_names() -> Vec<&'static str> {
+    UBX_NODE_PARAMETERS
+        .iter()
+        .map(|p| p.name)
+        .filter(|n| !n.ends_with("_topic") && ![USE_SIM_TIME, QUEUE_DEPTH].contains(n))
+        .collect()
 }
 
 fn root() -> &'static Path {
@@ -78,11 +91,12 @@ fn python_launch_file_parses_and_names_existing_things() {
 /// `launch` and `launch_ros` modules (there is no ROS here), its OpaqueFunction resolved
 /// with the launch arguments given as NAME=VALUE (the others keep their defaults).
 ///
-/// Mode `describe` prints one line per declared argument (`arg NAME=DEFAULT`), then
-/// `parameters REPR` (the node's parameters after the manual) and `remap FROM TO`.
+/// Mode `describe` prints one line per declared argument (`arg NAME=DEFAULT`), then per
+/// node `parameters REPR` (gnss_ins_node's after the manual) and `remap FROM TO`.
 ///
-/// Mode `argv` prints, as JSON, the command line launch_ros 0.26 (Jazzy) builds for the
-/// node, writing the temporary parameter file as it does. Read from launch_ros 0.26.6,
+/// Mode `describe` names each node (`node EXECUTABLE`) before its lines. Mode `argv`
+/// prints, as JSON, one line per node: the command line launch_ros 0.26 (Jazzy) builds for
+/// it, writing the temporary parameter file as it does. Read from launch_ros 0.26.6,
 /// launch_ros/actions/node.py (`Node.__init__`, `_perform_substitutions`, `execute`,
 /// `_create_params_file_from_dict`), utilities/namespace_utils.py (`prefix_namespace`,
 /// `make_namespace_absolute`), utilities/normalize_parameters.py (nested dicts flattened
@@ -183,13 +197,17 @@ for action in description.args[0]:
 for pair in sys.argv[3:]:
     name, value = pair.split('=', 1)
     context[name] = value
-(node,) = opaque.kwargs['function'](context)
-if mode == 'describe':
-    print('parameters', repr(node.kwargs['parameters'][1:]))
-    for old, new in node.kwargs['remappings']:
-        print('remap', old, new)
-else:
-    print(json.dumps(launch_ros_argv('gnss_ins_node', node.kwargs)))
+for node in opaque.kwargs['function'](context):
+    executable = node.kwargs['executable']
+    if mode == 'describe':
+        # gnss_ins_node's parameters after the manual; gnss_ins_ubx_node's all.
+        skip = 1 if executable == 'gnss_ins_node' else 0
+        print('node', executable)
+        print('parameters', repr(node.kwargs['parameters'][skip:]))
+        for old, new in node.kwargs['remappings']:
+            print('remap', old, new)
+    else:
+        print(json.dumps(launch_ros_argv(executable, node.kwargs)))
 "#;
 
 /// Runs the harness in `mode` with `args`, from the package root (where `ros2 launch`
@@ -238,6 +256,11 @@ impl LaunchedArgv {
             .map(PathBuf::from)
             .collect();
         Self { argv, temporary }
+    }
+
+    /// One per node: the lines of mode `argv`.
+    fn parse_each(json: &str) -> Vec<Self> {
+        json.lines().map(Self::parse).collect()
     }
 
     /// The node's parameters as it loads them from this command line.
@@ -370,6 +393,7 @@ fn launch_file_declares_the_nodes_parameters_and_passes_only_those_set() {
         .filter(|name| *name != "namespace")
         .collect();
     let mut node = node_parameter_names();
+    node.extend(ubx_launch_parameter_names());
     not_set.sort_unstable();
     node.sort_unstable();
     assert_eq!(not_set, node);
@@ -403,6 +427,72 @@ fn launch_file_declares_the_nodes_parameters_and_passes_only_those_set() {
         let e = run_launch_file(&[(name, bad)]).unwrap_err();
         assert!(e.contains(name), "{e}");
     }
+}
+
+/// `with_ubx_adapter:=true` starts gnss_ins_ubx_node beside gnss_ins_node, in the same
+/// namespace, with ublox_dgnss's topics at the root namespace remapped in, the IMU of
+/// gnss_ins_node, and its output on gnss_ins_node's GNSS input; the parameters set reach
+/// each node as it loads them (the shared ones both).
+#[test]
+fn with_ubx_adapter_starts_both_nodes_as_a_ublox_dgnss_user_needs() {
+    let json = run_launch_file_in(
+        "argv",
+        &[
+            ("with_ubx_adapter", "true"),
+            ("namespace", "robot"),
+            ("imu_topic", "/sensors/imu"),
+            ("time_base", "host"),
+            ("host_latency_s", "0.02"),
+            ("leap_seconds", "18"),
+            ("use_sim_time", "true"),
+        ],
+    )
+    .unwrap();
+    let nodes = LaunchedArgv::parse_each(&json);
+    assert_eq!(nodes.len(), 2, "{json}");
+    let (filter, ubx) = (&nodes[0], &nodes[1]);
+    assert_eq!(ubx.argv[0], "gnss_ins_ubx_node");
+    assert!(
+        !ubx.argv.iter().any(|a| a.ends_with("ekf.yaml")),
+        "the filter's manual is no parameter file of the adapter: {:?}",
+        ubx.argv
+    );
+    assert_eq!(
+        std::fs::read_to_string(&ubx.temporary[0]).unwrap(),
+        "/robot/gnss_ins_ubx_node:\n  ros__parameters:\n    host_latency_s: 0.02\n    \
+         leap_seconds: 18\n    time_base: host\n    use_sim_time: true\n"
+    );
+    let ubx_args = parse_as(ubx_node::DEFAULT_NODE_NAME, ubx.argv[1..].iter().cloned()).unwrap();
+    let p = ubx_node::params::load(&ubx_args).unwrap();
+    assert_eq!(p.adapter.time_base, TimeBase::Host);
+    assert_eq!(p.adapter.host_latency_s, 0.02);
+    assert!(p.use_sim_time);
+    assert!(filter.load().use_sim_time, "shared with gnss_ins_node");
+    let filter_args = parse(filter.argv[1..].iter().cloned()).unwrap();
+    let topic = |args: &NodeArgs, name: &str| {
+        resolve_remapped(name, &args.namespace, &args.node_name, &args.remaps)
+    };
+    assert_eq!(topic(&ubx_args, &p.topics.rawx), "/ubx_rxm_rawx");
+    assert_eq!(topic(&ubx_args, &p.topics.sfrbx), "/ubx_rxm_sfrbx");
+    assert_eq!(topic(&ubx_args, &p.topics.stream), "/robot/ubx_raw");
+    assert_eq!(topic(&ubx_args, &p.topics.imu), "/sensors/imu");
+    assert_eq!(topic(&filter_args, "imu"), "/sensors/imu");
+    assert_eq!(
+        topic(&ubx_args, &p.topics.measurements),
+        topic(&filter_args, "gnss/measurements"),
+        "the adapter publishes what the filter reads"
+    );
+    assert_eq!(
+        topic(&filter_args, "gnss/measurements"),
+        "/robot/gnss/measurements"
+    );
+
+    // Off by default; a set parameter of the wrong type is refused naming it.
+    let one = run_launch_file_in("argv", &[]).unwrap();
+    assert_eq!(LaunchedArgv::parse_each(&one).len(), 1);
+    let e =
+        run_launch_file(&[("with_ubx_adapter", "true"), ("host_latency_s", "soon")]).unwrap_err();
+    assert!(e.contains("host_latency_s"), "{e}");
 }
 
 #[test]

@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 
 use adaptive_gnss_ins::config::{self, manual, Assignment, Config, ConfigError};
 use adaptive_gnss_ins::ros::node::params;
+use adaptive_gnss_ins::ros::ubx_node;
 
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -43,7 +44,8 @@ fn the_manual_is_generated_from_the_table() {
 
 #[test]
 fn the_reference_is_generated_from_the_table() {
-    check_generated(root().join("docs/parameters.md"), &params::reference());
+    let reference = params::reference() + &ubx_node::params::reference_section();
+    check_generated(root().join("docs/parameters.md"), &reference);
 }
 
 /// The manual lists every parameter with its unit and its default, and loading it gives

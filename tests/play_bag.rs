@@ -8,6 +8,7 @@
 //! network namespace that has only loopback (`unshare -n`, needs root).
 
 mod netns_support;
+mod odometry_support;
 
 use std::path::Path;
 use std::process::{Command, Stdio};
@@ -22,6 +23,7 @@ use adaptive_gnss_ins::tools::bag_run::BagRun;
 use adaptive_gnss_ins::tools::replay::{replay, ReplayOptions, TruthSource};
 use adaptive_gnss_ins::tools::simulate::{simulate_with, SimulateOptions};
 use netns_support::reexec_in_private_netns;
+use odometry_support::{decoded, largest_difference};
 use ros2_client::{
     Context, ContextOptions, MessageTypeName, Name, Node, NodeName, NodeOptions, QosProfile,
     Subscription,
@@ -167,39 +169,6 @@ fn play_publishes_the_bag_unchanged() {
     );
 }
 
-/// The Odometry messages of a bag, in order.
-fn odometry_of(bag: &Path, topic: &str) -> Vec<Odometry> {
-    BagReader::open(bag)
-        .unwrap()
-        .messages()
-        .unwrap()
-        .map(Result::unwrap)
-        .filter(|m| m.topic == topic)
-        .map(|m| cdr::decode::<Odometry>(&m.data).unwrap())
-        .collect()
-}
-
-/// Largest difference between two solutions' positions, velocities and orientations.
-fn largest_difference(a: &Odometry, b: &Odometry) -> f64 {
-    let (pa, pb) = (&a.pose.pose.position, &b.pose.pose.position);
-    let (va, vb) = (&a.twist.twist.linear, &b.twist.twist.linear);
-    let (qa, qb) = (&a.pose.pose.orientation, &b.pose.pose.orientation);
-    [
-        pa.x - pb.x,
-        pa.y - pb.y,
-        pa.z - pb.z,
-        va.x - vb.x,
-        va.y - vb.y,
-        va.z - vb.z,
-        qa.x - qb.x,
-        qa.y - qb.y,
-        qa.z - qb.z,
-        qa.w - qb.w,
-    ]
-    .iter()
-    .fold(0.0_f64, |m, d| m.max(d.abs()))
-}
-
 #[test]
 fn node_records_the_replay_solution_of_a_played_bag() {
     if reexec_in_private_netns("node_records_the_replay_solution_of_a_played_bag") {
@@ -313,8 +282,8 @@ fn node_records_the_replay_solution(
         |_| {},
     )
     .unwrap();
-    let live = odometry_of(&recorded, "/odometry");
-    let offline = odometry_of(&replayed, "/odometry");
+    let live = decoded::<Odometry>(&recorded, "/odometry");
+    let offline = decoded::<Odometry>(&replayed, "/odometry");
     assert_eq!(
         live.len(),
         offline.len(),

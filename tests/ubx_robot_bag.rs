@@ -15,23 +15,17 @@ use adaptive_gnss_ins::ros::cdr;
 use adaptive_gnss_ins::ros::msg::{Imu, UInt8MultiArray, UbxRxmRawx, UbxRxmSfrbx};
 use adaptive_gnss_ins::ros::ubx_adapter::{TimeBase, DEFAULT_HOST_LATENCY_S};
 use adaptive_gnss_ins::tools::convert::{
-    convert, ConvertOptions, ConvertSummary, EphemerisMode, GnssSource, ImuInput, ImuTime,
-    TruthInput,
+    convert, ConvertOptions, ConvertSummary, EphemerisMode, GnssSource, ImuInput, TruthInput,
 };
 use adaptive_gnss_ins::tools::convert_bag::{RobotBag, RobotBagTopics, UbxInput};
-use adaptive_gnss_ins::tools::imu_csv::{AccelUnit, GyroUnit, ImuCsvFormat};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use ubx_robot_support::{driver_messages, host_ns, stream_chunk, walk_log, DriverMessage};
+use ubx_robot_support::{
+    driver_messages, host_ns, stream_chunk, walk_imu_input, walk_log, walk_path, DriverMessage,
+};
 
 const GNSS_OUT: &str = "/gnss/measurements";
 const IMU_OUT: &str = "/imu";
-
-fn data_path(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data/walk_0827")
-        .join(name)
-}
 
 fn options(gnss: GnssSource, imu: Option<ImuInput>) -> ConvertOptions {
     ConvertOptions {
@@ -46,20 +40,10 @@ fn options(gnss: GnssSource, imu: Option<ImuInput>) -> ConvertOptions {
 
 /// `convert --ubx gnss_1730.ubx --ephemeris as-received` with the walk's IMU.
 fn reference_bag(dir: &Path) -> (PathBuf, ConvertSummary) {
-    let imu = ImuInput {
-        csv: data_path("imu_1730.csv"),
-        format: ImuCsvFormat::new(
-            "ax,ay,az,gx,gy,gz,tick_ms",
-            AccelUnit::G,
-            GyroUnit::DegPerS,
-            [0.0; 3],
-        )
-        .unwrap(),
-        time: ImuTime::Tag(data_path("imu_1730.csv.tag")),
-    };
+    let imu = walk_imu_input([0.0; 3]);
     let out = dir.join("reference.mcap");
     let summary = convert(
-        &options(GnssSource::Ubx(data_path("gnss_1730.ubx")), Some(imu)),
+        &options(GnssSource::Ubx(walk_path("gnss_1730.ubx")), Some(imu)),
         &out,
     )
     .unwrap();

@@ -155,7 +155,8 @@ pub fn reference(node_rows: &[Row]) -> String {
     text
 }
 
-fn table(text: &mut String, rows: &[Row]) {
+/// Appends `rows` to `text` as a Markdown table of the reference.
+pub fn table(text: &mut String, rows: &[Row]) {
     text.push_str("| Parameter | Type | Unit | Default | Range | Run time | Meaning |\n");
     text.push_str("|---|---|---|---|---|---|---|\n");
     for r in rows {

@@ -230,13 +230,26 @@ const IGNORED_FLAGS: [(&str, bool, &str); 10] = [
     ),
 ];
 
-/// Parses the arguments after the program name.
+/// Parses the arguments after the program name, for `gnss_ins_node`.
 pub fn parse<I, S>(args: I) -> Result<NodeArgs, ArgsError>
 where
     I: IntoIterator<Item = S>,
     S: Into<String>,
 {
-    let mut out = NodeArgs::default();
+    parse_as(DEFAULT_NODE_NAME, args)
+}
+
+/// Parses the arguments after the program name for a node called `default_node_name`
+/// unless renamed (`NODE:` prefixes name the node by it).
+pub fn parse_as<I, S>(default_node_name: &str, args: I) -> Result<NodeArgs, ArgsError>
+where
+    I: IntoIterator<Item = S>,
+    S: Into<String>,
+{
+    let mut out = NodeArgs {
+        node_name: default_node_name.to_owned(),
+        ..NodeArgs::default()
+    };
     // Remappings with their node prefix, filtered once the node name is known.
     let mut remaps: Vec<(Option<String>, String, String)> = Vec::new();
     let mut in_ros_args = false;

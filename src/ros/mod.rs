@@ -20,6 +20,7 @@
 //! - [`player`]: `gnss_ins play`, a recorded bag published onto DDS.
 //! - [`ubx_adapter`]: the u-blox drivers' raw GNSS messages -> GnssMeasurements
 //!   (`gnss_ins convert --bag`, and the live adapter node).
+//! - [`ubx_node`]: the `gnss_ins_ubx_node` ROS 2 node around the adapter.
 
 pub mod adapter;
 pub mod args;
@@ -37,3 +38,4 @@ pub mod outbound;
 pub mod param_overrides;
 pub mod player;
 pub mod ubx_adapter;
+pub mod ubx_node;

@@ -12,29 +12,52 @@
 //! file position (GPST), here turned into UTC (GPST − 18 s).
 #![allow(dead_code)]
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use adaptive_gnss_ins::gnss::ubx::FrameReader;
 use adaptive_gnss_ins::ros::msg::{
     Header, MultiArrayDimension, MultiArrayLayout, RawxData, RecStat, Time, TrkStat,
     UInt8MultiArray, UbxRxmRawx, UbxRxmSfrbx,
 };
+use adaptive_gnss_ins::tools::convert::{ImuInput, ImuTime};
+use adaptive_gnss_ins::tools::imu_csv::{AccelUnit, GyroUnit, ImuCsvFormat};
 use adaptive_gnss_ins::tools::time_tag::{parse_time_tag, TimeTag};
 
 /// GPS − UTC during the recording (s).
 pub const LEAP_S: f64 = 18.0;
 
-/// The recording's file `name` (../shared/data/walk_0827).
-pub fn walk_file(name: &str) -> Vec<u8> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+/// The path of the recording's file `name` (../shared/data/walk_0827).
+pub fn walk_path(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../shared/data/walk_0827")
-        .join(name);
+        .join(name)
+}
+
+/// The recording's file `name`.
+pub fn walk_file(name: &str) -> Vec<u8> {
+    let path = walk_path(name);
     std::fs::read(&path).unwrap_or_else(|e| {
         panic!(
             "test data {} is missing ({e}): expected ../shared/data/walk_0827 beside the crate",
             path.display()
         )
     })
+}
+
+/// The walk's IMU CSV as `gnss_ins convert` reads it, its axes turned by `rpy_deg` (roll,
+/// pitch, yaw) into the body frame.
+pub fn walk_imu_input(rpy_deg: [f64; 3]) -> ImuInput {
+    ImuInput {
+        csv: walk_path("imu_1730.csv"),
+        format: ImuCsvFormat::new(
+            "ax,ay,az,gx,gy,gz,tick_ms",
+            AccelUnit::G,
+            GyroUnit::DegPerS,
+            rpy_deg,
+        )
+        .unwrap(),
+        time: ImuTime::Tag(walk_path("imu_1730.csv.tag")),
+    }
 }
 
 /// The log and its time tag.

@@ -71,7 +71,7 @@ pub struct ParameterServer {
     log: LogLimiter,
 }
 
-fn value(ptype: u8) -> ParameterValue {
+pub fn value(ptype: u8) -> ParameterValue {
     ParameterValue {
         ptype,
         boolean_value: false,
@@ -177,7 +177,7 @@ fn type_name(ptype: u8) -> &'static str {
     }
 }
 
-fn result(outcome: Result<(), String>) -> SetParametersResult {
+pub fn result(outcome: Result<(), String>) -> SetParametersResult {
     match outcome {
         Ok(()) => SetParametersResult {
             successful: true,
@@ -193,7 +193,7 @@ fn result(outcome: Result<(), String>) -> SetParametersResult {
 /// Whether `name` is listed for a request with `prefixes` and `depth` (rcl's rule: without
 /// prefixes every name with fewer than `depth` separators; with prefixes the names equal to
 /// one or below it, less than `depth` separators deeper).
-fn listed(name: &str, prefixes: &[String], depth: u64) -> bool {
+pub fn listed(name: &str, prefixes: &[String], depth: u64) -> bool {
     let separators = |s: &str| s.matches(SEPARATOR).count() as u64;
     let shallow = |rest: &str| depth == DEPTH_RECURSIVE || separators(rest) < depth;
     if prefixes.is_empty() {
@@ -206,6 +206,39 @@ fn listed(name: &str, prefixes: &[String], depth: u64) -> bool {
                 .and_then(|rest| rest.strip_prefix(SEPARATOR))
                 .is_some_and(shallow)
     })
+}
+
+/// The first [`MAX_NAMES`] of `names` (a longer request is logged on `log`).
+pub fn bounded_names<'a>(log: &mut LogLimiter, names: &'a [String], service: &str) -> &'a [String] {
+    if names.len() > MAX_NAMES {
+        log.warn(
+            service,
+            &format!(
+                "{service}: a request for {} names, only the first {MAX_NAMES} answered",
+                names.len()
+            ),
+        );
+    }
+    &names[..names.len().min(MAX_NAMES)]
+}
+
+/// Drops entries from the end of `response` (with `pop`) until its payload fits
+/// [`MAX_REPLY_BYTES`] (logged on `log` when it did not).
+pub fn fit<R: serde::Serialize>(
+    log: &mut LogLimiter,
+    service: &str,
+    response: &mut R,
+    pop: impl Fn(&mut R) -> bool,
+) {
+    let size = |r: &R| cdr::encode(r).map_or(usize::MAX, |b| b.len());
+    if size(response) <= MAX_REPLY_BYTES {
+        return;
+    }
+    while size(response) > MAX_REPLY_BYTES && pop(response) {}
+    log.warn(
+        service,
+        &format!("{service}: reply cut to {MAX_REPLY_BYTES} bytes"),
+    );
 }
 
 impl ParameterServer {
@@ -285,7 +318,7 @@ impl ParameterServer {
 
     /// `get_parameters`: one value per name, NOT_SET for an unknown name.
     pub fn get(&mut self, config: &Config, names: &[String]) -> GetParametersResponse {
-        let names = self.bounded_names(names, "get_parameters");
+        let names = bounded_names(&mut self.log, names, "get_parameters");
         let mut response = GetParametersResponse {
             values: names
                 .iter()
@@ -295,7 +328,7 @@ impl ParameterServer {
                 })
                 .collect(),
         };
-        self.fit("get_parameters", &mut response, |r| {
+        fit(&mut self.log, "get_parameters", &mut response, |r| {
             r.values.pop().is_some()
         });
         response
@@ -316,13 +349,13 @@ impl ParameterServer {
     /// `describe_parameters`: type, description, range and read-only flag from the
     /// parameter table (or the node's own declarations).
     pub fn describe(&mut self, config: &Config, names: &[String]) -> DescribeParametersResponse {
-        let names = self.bounded_names(names, "describe_parameters");
+        let names = bounded_names(&mut self.log, names, "describe_parameters");
         let values = names
             .iter()
             .map(|name| self.descriptor(config, name))
             .collect();
         let mut response = DescribeParametersResponse { values };
-        self.fit("describe_parameters", &mut response, |r| {
+        fit(&mut self.log, "describe_parameters", &mut response, |r| {
             r.values.pop().is_some()
         });
         response
@@ -375,39 +408,6 @@ impl ParameterServer {
         }
     }
 
-    /// The first [`MAX_NAMES`] of `names` (a longer request is logged, rate-limited).
-    fn bounded_names<'a>(&mut self, names: &'a [String], service: &str) -> &'a [String] {
-        if names.len() > MAX_NAMES {
-            self.refused(
-                service,
-                &format!(
-                    "{service}: a request for {} names, only the first {MAX_NAMES} answered",
-                    names.len()
-                ),
-            );
-        }
-        &names[..names.len().min(MAX_NAMES)]
-    }
-
-    /// Drops entries from the end of `response` (with `pop`) until its payload fits
-    /// [`MAX_REPLY_BYTES`].
-    fn fit<R: serde::Serialize>(
-        &mut self,
-        service: &str,
-        response: &mut R,
-        pop: impl Fn(&mut R) -> bool,
-    ) {
-        let size = |r: &R| cdr::encode(r).map_or(usize::MAX, |b| b.len());
-        if size(response) <= MAX_REPLY_BYTES {
-            return;
-        }
-        while size(response) > MAX_REPLY_BYTES && pop(response) {}
-        self.refused(
-            service,
-            &format!("{service}: reply cut to {MAX_REPLY_BYTES} bytes"),
-        );
-    }
-
     /// Logs a refusal, rate-limited per kind (issue 12: a flood of bad requests must not
     /// flood stderr and /rosout).
     fn refused(&mut self, kind: &str, message: &str) {
@@ -446,7 +446,7 @@ impl ParameterServer {
         Ok(next)
     }
 
-    fn sim_time_value(param: &Parameter) -> Result<bool, String> {
+    pub fn sim_time_value(param: &Parameter) -> Result<bool, String> {
         if param.value.ptype == ParameterType::BOOL {
             Ok(param.value.boolean_value)
         } else {
@@ -488,7 +488,7 @@ impl ParameterServer {
             })
             .collect();
         let mut response = SetParametersResponse { results };
-        self.fit("set_parameters", &mut response, |r| {
+        fit(&mut self.log, "set_parameters", &mut response, |r| {
             r.results.pop().is_some()
         });
         response
@@ -552,7 +552,7 @@ impl ParameterServer {
 }
 
 /// Refuses a name or a value longer than any parameter's, without quoting it.
-fn oversized(p: &Parameter) -> Result<(), String> {
+pub fn oversized(p: &Parameter) -> Result<(), String> {
     if p.name.len() > MAX_NAME_BYTES {
         return Err(format!(
             "a parameter name of {} bytes (the longest is {MAX_NAME_BYTES})",

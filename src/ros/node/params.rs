@@ -84,20 +84,33 @@ pub struct NodeParameter {
     pub doc: &'static str,
 }
 
+/// [`USE_SIM_TIME`], a parameter of both nodes.
+pub const USE_SIM_TIME_PARAMETER: NodeParameter = NodeParameter {
+    name: USE_SIM_TIME,
+    kind: Kind::Bool,
+    default: "false",
+    range: "true or false",
+    runtime: true,
+    doc: "The node's time (diagnostics and rosout stamps, input ages) follows /clock.",
+};
+
+/// [`QUEUE_DEPTH`], a parameter of both nodes.
+pub const QUEUE_DEPTH_PARAMETER: NodeParameter = NodeParameter {
+    name: QUEUE_DEPTH,
+    kind: Kind::Integer,
+    default: "200",
+    range: "an integer in [1, 60000]",
+    runtime: false,
+    doc: "History depth (messages) of the input subscriptions and the publishers.",
+};
+
 /// The node's own parameters.
 ///
 /// Choice: the frames, the TF switch and the queue depth are fixed at start (read-only
 /// through the parameter services): a TF tree whose frames change while it runs would
 /// break its listeners, and the DDS entities are created with the depth.
 pub const NODE_PARAMETERS: [NodeParameter; 5] = [
-    NodeParameter {
-        name: USE_SIM_TIME,
-        kind: Kind::Bool,
-        default: "false",
-        range: "true or false",
-        runtime: true,
-        doc: "The node's time (diagnostics and rosout stamps, input ages) follows /clock.",
-    },
+    USE_SIM_TIME_PARAMETER,
     NodeParameter {
         name: MAP_FRAME,
         kind: Kind::Text,
@@ -122,20 +135,18 @@ pub const NODE_PARAMETERS: [NodeParameter; 5] = [
         runtime: false,
         doc: "Publish map_frame -> base_frame on /tf with each odometry.",
     },
-    NodeParameter {
-        name: QUEUE_DEPTH,
-        kind: Kind::Integer,
-        default: "200",
-        range: "an integer in [1, 60000]",
-        runtime: false,
-        doc: "History depth (messages) of the input subscriptions and the publishers.",
-    },
+    QUEUE_DEPTH_PARAMETER,
 ];
 
 impl NodeParameter {
     /// The node parameter called `name`.
     pub fn named(name: &str) -> Option<&'static NodeParameter> {
-        NODE_PARAMETERS.iter().find(|p| p.name == name)
+        Self::named_in(&NODE_PARAMETERS, name)
+    }
+
+    /// The parameter of `table` called `name`.
+    pub fn named_in(table: &'static [NodeParameter], name: &str) -> Option<&'static NodeParameter> {
+        table.iter().find(|p| p.name == name)
     }
 
     /// The description the parameter services give.
@@ -160,7 +171,8 @@ impl NodeParameter {
     }
 }
 
-/// `docs/parameters.md`: the core's parameters and the node's.
+/// `docs/parameters.md` up to `gnss_ins_ubx_node`'s section: the core's parameters and
+/// the node's.
 pub fn reference() -> String {
     let rows: Vec<Row> = NODE_PARAMETERS.iter().map(NodeParameter::row).collect();
     crate::config::manual::reference(&rows)
@@ -211,7 +223,7 @@ pub fn node_params_from(values: &[Assignment]) -> Result<NodeParams, ParamsError
     })
 }
 
-fn refused(a: &Assignment, name: &'static str, reason: &'static str) -> ParamsError {
+pub(crate) fn refused(a: &Assignment, name: &'static str, reason: &'static str) -> ParamsError {
     ParamsError::NodeParameter {
         origin: a.origin.clone(),
         name,
@@ -220,7 +232,11 @@ fn refused(a: &Assignment, name: &'static str, reason: &'static str) -> ParamsEr
     }
 }
 
-fn boolean(a: Option<&Assignment>, name: &'static str, default: bool) -> Result<bool, ParamsError> {
+pub(crate) fn boolean(
+    a: Option<&Assignment>,
+    name: &'static str,
+    default: bool,
+) -> Result<bool, ParamsError> {
     match a {
         None => Ok(default),
         Some(a) => a
@@ -231,7 +247,11 @@ fn boolean(a: Option<&Assignment>, name: &'static str, default: bool) -> Result<
 }
 
 /// A frame id: a non-empty string without spaces.
-fn frame(a: Option<&Assignment>, name: &'static str, default: &str) -> Result<String, ParamsError> {
+pub(crate) fn frame(
+    a: Option<&Assignment>,
+    name: &'static str,
+    default: &str,
+) -> Result<String, ParamsError> {
     match a {
         None => Ok(default.to_owned()),
         Some(Assignment {
@@ -247,7 +267,7 @@ fn frame(a: Option<&Assignment>, name: &'static str, default: &str) -> Result<St
 }
 
 /// A history depth: an integer in 1..=[`MAX_QUEUE_DEPTH`].
-fn depth(a: Option<&Assignment>) -> Result<usize, ParamsError> {
+pub(crate) fn depth(a: Option<&Assignment>) -> Result<usize, ParamsError> {
     match a {
         None => Ok(DEFAULT_QUEUE_DEPTH),
         Some(a) => a
@@ -317,9 +337,14 @@ fn overrides(
 
 /// Reads the parameter files of `args` and builds the node's parameters.
 pub fn load(args: &NodeArgs) -> Result<NodeParams, ParamsError> {
+    node_params_from(&resolved(args)?)
+}
+
+/// The parameter values the files and rules of `args` give the node it names, as rclcpp
+/// resolves them.
+pub fn resolved(args: &NodeArgs) -> Result<Vec<Assignment>, ParamsError> {
     let fqn = args.fully_qualified_name();
-    let overrides = overrides(&args.parameter_sources, &fqn, &args.node_name)?;
-    node_params_from(&overrides.for_node(&fqn))
+    Ok(overrides(&args.parameter_sources, &fqn, &args.node_name)?.for_node(&fqn))
 }
 
 /// The configuration of `replay`, `compare` and `spp` from their `--params` files, read

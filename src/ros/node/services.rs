@@ -14,8 +14,10 @@ use ros2_client::{
     ServiceTypeName,
 };
 
+use ros2_client::parameters::raw::Parameter;
+
+use super::dds::{dds_error, NodeError};
 use super::param_server::ParameterServer;
-use super::{dds_error, NodeError};
 use crate::ros::adapter::RosAdapter;
 
 /// The request/reply mapping of the ROS 2 middleware named by `RMW_IMPLEMENTATION`.
@@ -138,43 +140,73 @@ impl ParameterServices {
         ]
     }
 
-    /// Answers `request` (setting parameters on `core` and `params`).
-    pub fn answer(
-        &self,
-        request: ParamRequest,
-        params: &mut ParameterServer,
-        core: &mut RosAdapter,
-    ) {
-        let config = core.engine().config().clone();
+    /// Answers `request` with `handler`.
+    pub fn answer(&self, request: ParamRequest, handler: &mut impl ParameterHandler) {
         match request {
             ParamRequest::List(id, r) => sent(
                 "list_parameters",
-                self.list.send_response(id, params.list(&config, &r)),
+                self.list.send_response(id, handler.list(&r)),
             ),
             ParamRequest::Get(id, r) => sent(
                 "get_parameters",
-                self.get.send_response(id, params.get(&config, &r.names)),
+                self.get.send_response(id, handler.get(&r.names)),
             ),
             ParamRequest::Types(id, r) => sent(
                 "get_parameter_types",
-                self.types
-                    .send_response(id, params.types(&config, &r.names)),
+                self.types.send_response(id, handler.types(&r.names)),
             ),
             ParamRequest::Set(id, r) => sent(
                 "set_parameters",
-                self.set.send_response(id, params.set(core, &r.parameter)),
+                self.set.send_response(id, handler.set(&r.parameter)),
             ),
             ParamRequest::SetAtomically(id, r) => sent(
                 "set_parameters_atomically",
                 self.set_atomically
-                    .send_response(id, params.set_atomically(core, &r.parameter)),
+                    .send_response(id, handler.set_atomically(&r.parameter)),
             ),
             ParamRequest::Describe(id, r) => sent(
                 "describe_parameters",
-                self.describe
-                    .send_response(id, params.describe(&config, &r.names)),
+                self.describe.send_response(id, handler.describe(&r.names)),
             ),
         }
+    }
+}
+
+/// What answers the parameter services of a node: one method per service.
+pub trait ParameterHandler {
+    fn list(&mut self, request: &ListParametersRequest) -> ListParametersResponse;
+    fn get(&mut self, names: &[String]) -> GetParametersResponse;
+    fn types(&mut self, names: &[String]) -> GetParameterTypesResponse;
+    fn describe(&mut self, names: &[String]) -> DescribeParametersResponse;
+    fn set(&mut self, params: &[Parameter]) -> SetParametersResponse;
+    fn set_atomically(&mut self, params: &[Parameter]) -> SetParametersAtomicallyResponse;
+}
+
+/// `gnss_ins_node`'s parameters: the node's own in `server`, the configuration of
+/// `core`'s engine (run-time parameters are set on it).
+pub struct CoreParameters<'a> {
+    pub server: &'a mut ParameterServer,
+    pub core: &'a mut RosAdapter,
+}
+
+impl ParameterHandler for CoreParameters<'_> {
+    fn list(&mut self, request: &ListParametersRequest) -> ListParametersResponse {
+        self.server.list(self.core.engine().config(), request)
+    }
+    fn get(&mut self, names: &[String]) -> GetParametersResponse {
+        self.server.get(self.core.engine().config(), names)
+    }
+    fn types(&mut self, names: &[String]) -> GetParameterTypesResponse {
+        self.server.types(self.core.engine().config(), names)
+    }
+    fn describe(&mut self, names: &[String]) -> DescribeParametersResponse {
+        self.server.describe(self.core.engine().config(), names)
+    }
+    fn set(&mut self, params: &[Parameter]) -> SetParametersResponse {
+        self.server.set(self.core, params)
+    }
+    fn set_atomically(&mut self, params: &[Parameter]) -> SetParametersAtomicallyResponse {
+        self.server.set_atomically(self.core, params)
     }
 }
 

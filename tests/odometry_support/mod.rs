@@ -1,0 +1,42 @@
+//! Solutions compared: the messages of a bag's topic, and the largest difference between
+//! two Odometry messages.
+#![allow(dead_code)]
+
+use std::path::Path;
+
+use adaptive_gnss_ins::ros::bag::BagReader;
+use adaptive_gnss_ins::ros::cdr;
+use adaptive_gnss_ins::ros::msg::{Odometry, RosMessage};
+
+/// The messages of `topic` in `bag`, in log-time order.
+pub fn decoded<M: RosMessage>(bag: &Path, topic: &str) -> Vec<M> {
+    BagReader::open(bag)
+        .unwrap()
+        .messages()
+        .unwrap()
+        .map(Result::unwrap)
+        .filter(|m| m.topic == topic)
+        .map(|m| cdr::decode::<M>(&m.data).unwrap())
+        .collect()
+}
+
+/// Largest difference between two solutions' positions, velocities and orientations.
+pub fn largest_difference(a: &Odometry, b: &Odometry) -> f64 {
+    let (pa, pb) = (&a.pose.pose.position, &b.pose.pose.position);
+    let (va, vb) = (&a.twist.twist.linear, &b.twist.twist.linear);
+    let (qa, qb) = (&a.pose.pose.orientation, &b.pose.pose.orientation);
+    [
+        pa.x - pb.x,
+        pa.y - pb.y,
+        pa.z - pb.z,
+        va.x - vb.x,
+        va.y - vb.y,
+        va.z - vb.z,
+        qa.x - qb.x,
+        qa.y - qb.y,
+        qa.z - qb.z,
+        qa.w - qb.w,
+    ]
+    .iter()
+    .fold(0.0_f64, |m, d| m.max(d.abs()))
+}
