@@ -17,11 +17,14 @@
 //! - A measurement older than the last IMU sample (late delivery) rolls the filter back to
 //!   the last stored state before it, applies it, and re-integrates the buffered IMU
 //!   samples; one older than `engine.imu_buffer_s` is rejected and counted.
+//! - IMU samples are screened first ([`imu_screen`]): one beyond the sensor's range or a
+//!   lone spike is dropped and counted, and the strapdown step spans it.
 
 mod adaptation;
 pub mod adaptive_noise;
 mod filter_state;
 pub mod fix_pairing;
+pub mod imu_screen;
 mod initializer;
 mod output;
 pub mod q_scaling;
@@ -35,6 +38,8 @@ use crate::config::{Config, Coupling};
 use crate::filter::process_model::ProcessNoise;
 use crate::gnss::GnssEpoch;
 use crate::ins::ImuSample;
+
+use imu_screen::{ImuScreen, Screened};
 
 pub use adaptation::Adaptation;
 pub use filter_state::{interpolate, FilterState};
@@ -104,6 +109,8 @@ pub struct Engine {
     /// re-integrated after a roll-back use the scale of now; the estimators learn only from
     /// measurements seen for the first time.
     adaptation: Adaptation,
+    /// The IMU samples' screen (range and spikes).
+    screen: ImuScreen,
 }
 
 impl Engine {
@@ -120,6 +127,7 @@ impl Engine {
             last_output_t_s: f64::NEG_INFINITY,
             counters: RejectionCounters::default(),
             replaying: false,
+            screen: ImuScreen::default(),
         }
     }
 
@@ -208,7 +216,22 @@ impl Engine {
                     .counters
                     .reject(RejectionReason::ImuOutOfOrder, body.t_s));
             }
-            if dt > self.config.engine.max_imu_gap_s {
+        }
+        match self.screen.screen(sample, &self.config.imu) {
+            Screened::Kept => {}
+            Screened::OutOfRange => {
+                return Err(self
+                    .counters
+                    .reject(RejectionReason::ImuOutOfRange, body.t_s))
+            }
+            Screened::Spike => {
+                return Err(self
+                    .counters
+                    .reject(RejectionReason::ImuInconsistent, body.t_s))
+            }
+        }
+        if let Some(last) = self.imu.back() {
+            if body.t_s - last.t_s > self.config.engine.max_imu_gap_s {
                 self.counters.reject(RejectionReason::ImuGap, body.t_s);
                 out.push(self.reset(body.t_s, ResetReason::ImuGap));
             }
