@@ -18,10 +18,10 @@ use crate::config::ImuConfig;
 use crate::ins::ImuSample;
 
 /// Consecutive agreeing samples that confirm a new level.
-const CONFIRMING_SAMPLES: usize = 3;
+pub const CONFIRMING_SAMPLES: usize = 3;
 /// Largest age of the last kept sample for the step test (s): the step limits are changes
 /// from one sample to the next, and IMUs sample at 10 Hz or faster.
-const NEIGHBOUR_S: f64 = 0.1;
+pub const NEIGHBOUR_S: f64 = 0.1;
 
 /// What the screen made of a sample.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -17,7 +17,7 @@
 //! - A measurement older than the last IMU sample (late delivery) rolls the filter back to
 //!   the last stored state before it, applies it, and re-integrates the buffered IMU
 //!   samples; one older than `engine.imu_buffer_s` is rejected and counted.
-//! - Start-up ([`initializer`]): levelled at rest, or aligned in motion from GNSS when
+//! - Start-up (`initializer`): levelled at rest, or aligned in motion from GNSS when
 //!   the IMU's window is not at rest (a start or a restart mid-drive); a start whose
 //!   heading is too uncertain for one filter runs a bank of heading hypotheses first
 //!   ([`heading_bank`]), and nothing is published until it has decided.

@@ -3,7 +3,7 @@
 //! vibration at rest, the road's and the engine's when moving) and the mean rate (a steady
 //! turn has a steady rate). The initializer confirms a verdict of rest with the GNSS speed
 //! when it has one: a vehicle cruising straight at constant speed is, to an IMU without
-//! vibration, at rest. The levelling at start-up ([`super::initializer`]) takes its
+//! vibration, at rest. The levelling at start-up (`initializer`) takes its
 //! attitude and gyro bias only from a window at rest.
 //!
 //! Choice (thresholds): from the IMU's own noise model, so that each IMU class gets its
