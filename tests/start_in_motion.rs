@@ -10,9 +10,10 @@
 //! its heading within 5° 20 s after moving off (and within 3σ of its own σ after that).
 
 use adaptive_gnss_ins::config::{Config, Coupling};
-use adaptive_gnss_ins::engine::{Engine, InitPhase, Output, StatusEvent};
+use adaptive_gnss_ins::engine::{Engine, FilterState, InitPhase, Output, StatusEvent};
 use adaptive_gnss_ins::eval;
 use adaptive_gnss_ins::ins::error_state::PHI;
+use adaptive_gnss_ins::ins::NavState;
 use adaptive_gnss_ins::sim::constellation::GpsConstellation;
 use adaptive_gnss_ins::sim::{ImuErrorModel, ImuErrorSpec, Segment, Trajectory, TrajectorySpec};
 use rand_chacha::rand_core::SeedableRng;
@@ -109,6 +110,20 @@ fn drive(start: Start) -> (TrajectorySpec, f64) {
     (spec, feed_start_s)
 }
 
+/// The errors of the filter's solution against the truth `nav` (at the same time), and
+/// its yaw error (deg).
+fn error_against(state: &FilterState, nav: &NavState) -> (eval::SolutionError, f64) {
+    let reference = eval::TruthSample {
+        t_s: nav.t_s,
+        p: nav.p,
+        v_n: Some(nav.v_n),
+        q_nb: Some(nav.q_nb),
+    };
+    let error = eval::solution_error(&state.solution(), &reference);
+    let yaw_deg = error.attitude_rpy_rad.unwrap()[2].to_degrees().abs();
+    (error, yaw_deg)
+}
+
 /// Runs the engine on `start`; returns the number of scored epochs after asserting them.
 fn run(start: Start, coupling: Coupling) -> usize {
     let name = format!("{start:?} {coupling:?}");
@@ -157,14 +172,7 @@ fn run(start: Start, coupling: Coupling) -> usize {
         let state = engine
             .state()
             .unwrap_or_else(|| panic!("{name}: not running at {t} s"));
-        let reference = eval::TruthSample {
-            t_s: t,
-            p: truth.nav.p,
-            v_n: Some(truth.nav.v_n),
-            q_nb: Some(truth.nav.q_nb),
-        };
-        let error = eval::solution_error(&state.solution(), &reference);
-        let yaw_deg = error.attitude_rpy_rad.unwrap()[2].to_degrees().abs();
+        let (error, yaw_deg) = error_against(state, &truth.nav);
         worst_yaw_deg = worst_yaw_deg.max(yaw_deg);
         worst_nees = worst_nees.max(error.nees);
         scored += 1;
@@ -188,28 +196,25 @@ fn run(start: Start, coupling: Coupling) -> usize {
     scored
 }
 
+/// The starts of the issue: at rest, and at 5 and 20 m/s straight and in a turn.
+const STARTS: [Start; 5] = [
+    Start::AtRest,
+    Start::Straight(5.0),
+    Start::Straight(20.0),
+    Start::Turning(5.0),
+    Start::Turning(20.0),
+];
+
 #[test]
 fn tightly_coupled_starts_at_rest_cruising_and_turning() {
-    for start in [
-        Start::AtRest,
-        Start::Straight(5.0),
-        Start::Straight(20.0),
-        Start::Turning(5.0),
-        Start::Turning(20.0),
-    ] {
+    for start in STARTS {
         run(start, Coupling::Tight);
     }
 }
 
 #[test]
 fn loosely_coupled_starts_at_rest_cruising_and_turning() {
-    for start in [
-        Start::AtRest,
-        Start::Straight(5.0),
-        Start::Straight(20.0),
-        Start::Turning(5.0),
-        Start::Turning(20.0),
-    ] {
+    for start in STARTS {
         run(start, Coupling::Loose);
     }
 }
@@ -278,14 +283,7 @@ fn loosely_coupled_takes_no_heading_from_fix_noise_at_a_standstill() {
             let state = engine
                 .state()
                 .unwrap_or_else(|| panic!("seed {seed}: not running at {t} s"));
-            let reference = eval::TruthSample {
-                t_s: t,
-                p: truth.nav.p,
-                v_n: Some(truth.nav.v_n),
-                q_nb: Some(truth.nav.q_nb),
-            };
-            let error = eval::solution_error(&state.solution(), &reference);
-            let yaw_deg = error.attitude_rpy_rad.unwrap()[2].to_degrees().abs();
+            let (_, yaw_deg) = error_against(state, &truth.nav);
             if t == PARKED_S + 20.0 {
                 at_20_s_deg = yaw_deg;
                 assert!(
@@ -293,9 +291,11 @@ fn loosely_coupled_takes_no_heading_from_fix_noise_at_a_standstill() {
                     "seed {seed}: heading error {yaw_deg:.2}° 20 s after moving off"
                 );
             }
-            // Later the heading is not held to a bound: see the note in the report
-            // (after the turn, on the straight, the error wanders with the fixes' slow error,
-            // which the filter takes for white noise).
+            // Later the heading is only printed, in units of its σ: on the straight after
+            // the turn it wanders with the fixes' slow error, which the filter takes for
+            // white noise, and reached 3.05σ (seed 2) when this test was written — the
+            // loosely-coupled filter's over-confidence under correlated fix errors, which
+            // the start-up does not cause and this test does not hide.
             let yaw_sigma_deg = state.p[(PHI + 2, PHI + 2)].sqrt().to_degrees();
             worst_in_sigma = worst_in_sigma.max(yaw_deg / yaw_sigma_deg);
         }
@@ -346,14 +346,7 @@ fn a_coarse_start_runs_the_heading_bank_and_converges() {
                 continue;
             }
             let state = engine.state().expect("running");
-            let reference = eval::TruthSample {
-                t_s: t,
-                p: truth.nav.p,
-                v_n: None,
-                q_nb: Some(truth.nav.q_nb),
-            };
-            let error = eval::solution_error(&state.solution(), &reference);
-            let yaw_deg = error.attitude_rpy_rad.unwrap()[2].to_degrees().abs();
+            let (_, yaw_deg) = error_against(state, &truth.nav);
             let yaw_sigma_deg = state.p[(PHI + 2, PHI + 2)].sqrt().to_degrees();
             worst_deg = worst_deg.max(yaw_deg);
             scored += 1;
