@@ -28,9 +28,7 @@
 //!    A heading σ above [`super::heading_bank::BANK_ABOVE_RAD`] is resolved by the engine's bank of
 //!    heading hypotheses ([`super::heading_bank`]).
 
-use nalgebra::{UnitQuaternion, Vector3};
-
-use nalgebra::{Matrix2, Matrix3, Vector2};
+use nalgebra::{Matrix2, Matrix3, UnitQuaternion, Vector2, Vector3};
 
 use crate::config::Config;
 use crate::earth::{self, Llh};
