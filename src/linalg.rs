@@ -272,6 +272,21 @@ impl SpdFactor {
         }
     }
 
+    /// ln det of the (repaired) matrix.
+    pub fn log_det(&self) -> f64 {
+        let log_diagonal = |m: &DMatrix<f64>| m.diagonal().iter().map(|v| v.ln()).sum::<f64>();
+        let log_scale = |scale: &DVector<f64>| 2.0 * scale.iter().map(|s| s.ln()).sum::<f64>();
+        match &self.inner {
+            Inner::Plain(chol) => 2.0 * log_diagonal(&chol.l()),
+            Inner::ScaledCholesky { scale, chol } => {
+                log_scale(scale) + 2.0 * log_diagonal(&chol.l())
+            }
+            Inner::ScaledEigen { scale, values, .. } => {
+                log_scale(scale) + values.iter().map(|v| v.ln()).sum::<f64>()
+            }
+        }
+    }
+
     /// `A⁻¹ b` for a vector `b` with [`Self::dimension`] rows.
     pub fn solve_vector(&self, b: &DVector<f64>) -> DVector<f64> {
         let x = self.solve(&DMatrix::from_column_slice(b.len(), 1, b.as_slice()));

@@ -63,6 +63,10 @@ const EVERY_KEY_CHANGED: &str = "
       accel_vrw_ug_per_sqrt_hz: 57.0
       accel_bias_ug: 321.0
       accel_bias_correlation_time_s: 777.0
+      gyro_range_deg_per_s: 2000.0
+      accel_range_g: 16.0
+      gyro_max_step_deg_per_s: 0.0
+      accel_max_step_g: 8.0
     mounting:
       imu_rotation_rpy_deg: [1.5, -2.25, 179.0]
       antenna_lever_arm_m: [0.31, -0.12, 1.07]
@@ -249,7 +253,9 @@ fn every_overlay_over_the_manual_is_the_full_preset_it_replaced() {
     let mut compared = 0;
     for path in preset_files() {
         let name = path.file_name().unwrap().to_string_lossy().into_owned();
-        if name == "ekf.yaml" {
+        // The IMU-class overlays (params/imu_*.yaml, issue 11) came after the overlays
+        // replaced the full presets: there is no full file they replaced.
+        if name == "ekf.yaml" || name.starts_with("imu_") {
             continue;
         }
         let full = std::fs::read_to_string(before.join(&name))

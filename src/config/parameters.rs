@@ -13,7 +13,7 @@ use nalgebra::{UnitQuaternion, Vector3};
 
 use super::convert::{
     ByName, LlhDegToPosition, RpyDegToRotation, Scale, ToVector, M_S2_PER_UG, RAD_PER_DEG,
-    RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H, RAD_S_PER_DEG_H,
+    RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H, RAD_S_PER_DEG_H, STANDARD_GRAVITY_M_S2,
 };
 use super::file_value::ConstellationName;
 use super::spec::{Interval, Range};
@@ -40,6 +40,8 @@ const THRESHOLD: Range = Range::Within(Interval::above(0.0, 1e3));
 const MAX_WINDOW_EPOCHS: u64 = 10_000;
 /// A fraction in (0, 1].
 const FRACTION: Range = Range::Within(Interval::above(0.0, 1.0));
+/// A sensor's measurement range, above 0.
+const RANGE: Range = Range::Within(Interval::above(0.0, 1e6));
 /// A factor bound at least 1 (and finite).
 const FACTOR_MAX: Range = Range::Within(Interval::closed(1.0, 1e12));
 const ANY: Range = Range::Any;
@@ -101,6 +103,21 @@ parameter_table! {
         /// Correlation time of the accelerometer Gauss-Markov bias.
         accel_markov_time_s: f64 ["accel_bias_correlation_time_s": f64] = 3600.0,
             unit "s", range TIME_CONSTANT, at_start;
+        /// Gyro range per axis; a sample beyond it is dropped (imu_out_of_range).
+        gyro_range_rad_s: f64 ["gyro_range_deg_per_s": f64] = 490.0,
+            unit "deg/s", range RANGE, at_run_time, si Scale::to("rad/s", RAD_PER_DEG);
+        /// Accelerometer range per axis (as gyro_range_deg_per_s).
+        accel_range_m_s2: f64 ["accel_range_g": f64] = 10.0,
+            unit "g", range RANGE, at_run_time, si Scale::to("m/s^2", STANDARD_GRAVITY_M_S2);
+        /// Largest gyro change between samples; a lone larger jump is dropped
+        /// (imu_inconsistent). 0 = off.
+        gyro_step_max_rad_s: f64 ["gyro_max_step_deg_per_s": f64] = 100.0,
+            unit "deg/s", range Range::OffOrWithin(Interval::above(0.0, 1e6)), at_run_time,
+            si Scale::to("rad/s", RAD_PER_DEG);
+        /// Largest accelerometer change between samples (as gyro_max_step_deg_per_s).
+        accel_step_max_m_s2: f64 ["accel_max_step_g": f64] = 5.0,
+            unit "g", range Range::OffOrWithin(Interval::above(0.0, 1e6)), at_run_time,
+            si Scale::to("m/s^2", STANDARD_GRAVITY_M_S2);
     }
 
     /// IMU orientation and antenna lever arm.

@@ -1,16 +1,34 @@
 //! Start-up with no hand-entered state.
 //!
 //! 1. Levelling: roll and pitch from the mean specific force over
-//!    `init.leveling_duration_s` at rest, and the gyro bias from the mean angular rate
-//!    less the earth rate (resolved once the position and heading are known).
-//! 2. Until the filter starts, the attitude is carried forward by the gyros alone.
+//!    `init.leveling_duration_s`, and the gyro bias from the mean angular rate less the
+//!    earth rate (resolved once the position and heading are known) — only when the
+//!    window is at rest: the standstill test of [`super::standstill`] over the window, and
+//!    a GNSS speed (when one is known) below [`REST_SPEED_MAX_MPS`]. A moving
+//!    window gives no attitude and no gyro bias (a turn's rate is no bias); the next window
+//!    is tried.
+//! 2. Until the filter starts, the levelled attitude is carried forward by the gyros alone.
 //! 3. Position, velocity and clock come from an iterated least-squares single-point
 //!    solution (tightly coupled) or the receiver's fix (loosely coupled).
-//! 4. The heading is `init.heading_deg` (a compass heading) when given; otherwise the direction of the GNSS
-//!    velocity once the speed exceeds `init.heading_min_speed_mps`, assuming the body's
-//!    forward axis points along the motion (vehicles, walking with the device ahead).
+//! 4. The heading is `init.heading_deg` (a compass heading) when given; otherwise the
+//!    direction of the GNSS velocity once the platform moves, assuming the body's forward
+//!    axis points along the motion (vehicles, walking with the device ahead). Moving: the
+//!    horizontal speed exceeds `init.heading_min_speed_mps` and is significant against its
+//!    own covariance. Loosely coupled without a receiver velocity, the velocity is the
+//!    displacement of the fixes over up to [`super::fix_track::MAX_BASELINE_S`], and the platform moves
+//!    only once that displacement has been significant against the fixes' covariances for
+//!    [`MOTION_EPOCHS`] consecutive fixes: fix noise at a standstill gives no heading.
+//! 5. Not levelled and moving (a start in motion, a restart mid-drive): aligned in motion
+//!    from GNSS. Heading from the course; roll and pitch from the recent mean specific
+//!    force less the body acceleration that the GNSS speed and the gyros give (forward:
+//!    the change of speed; sideways and up: the rate times the speed, the centripetal
+//!    acceleration of a turn); gyro bias zero with the class's σ (`imu.gyro_bias_deg_per_h`).
+//!    The covariance covers the alignment's errors: the course's own uncertainty and
+//!    [`COURSE_SIGMA_RAD`] in the heading, the unknown acceleration in roll and pitch.
+//!    A heading σ above [`super::heading_bank::BANK_ABOVE_RAD`] is resolved by the engine's bank of
+//!    heading hypotheses ([`super::heading_bank`]).
 
-use nalgebra::{UnitQuaternion, Vector3};
+use nalgebra::{Matrix2, Matrix3, UnitQuaternion, Vector2, Vector3};
 
 use crate::config::Config;
 use crate::earth::{self, Llh};
@@ -21,7 +39,40 @@ use crate::ins::error_state::{
 };
 use crate::ins::{ImuSample, NavState};
 
+use super::fix_track::FixTrack;
+use super::standstill::MotionStatistics;
 use super::update::{sigma_model, GnssFix};
+
+/// 1-sigma of an acceleration along the body's forward axis that no GNSS speed difference
+/// measures (m/s²). Choice: a car's brisk acceleration or braking.
+const UNKNOWN_ACCELERATION_M_S2: f64 = 1.0;
+/// Longest interval between two GNSS speeds whose difference gives the forward
+/// acceleration of an alignment in motion, and the age up to which a GNSS speed counts in
+/// the levelling's rest test (s).
+const SPEED_AGE_S: f64 = 2.0;
+
+/// Consecutive fixes of significant displacement before a loosely-coupled start without
+/// a receiver velocity takes a heading. Choice: 3, so that one fix pulled by noise or an
+/// outlier does not set the heading.
+const MOTION_EPOCHS: usize = 3;
+/// 1-sigma of the body's forward axis against the course (rad): side-slip and the
+/// mounting's yaw. Choice: 3°, a car's side-slip in a brisk turn.
+const COURSE_SIGMA_RAD: f64 = 3.0 * std::f64::consts::PI / 180.0;
+/// A GNSS speed above this denies the levelling's rest (m/s). Choice: 0.5 m/s, above the
+/// speed noise of a single-point velocity and below a walking pace.
+const REST_SPEED_MAX_MPS: f64 = 0.5;
+/// Confidence of the test that a GNSS velocity differs from zero. Choice: 0.999, so that
+/// fix noise at a standstill passes it once in a thousand fixes, and [`MOTION_EPOCHS`]
+/// consecutive passes (loosely coupled) practically never.
+const MOTION_CONFIDENCE: f64 = 0.999;
+
+/// True when the horizontal vector `x` of covariance `cov` differs from zero beyond the
+/// chi-square quantile (two degrees of freedom: −2 ln(1 − p)) of [`MOTION_CONFIDENCE`].
+fn significant(x: &Vector2<f64>, cov: &Matrix2<f64>) -> bool {
+    let quantile = -2.0 * (1.0 - MOTION_CONFIDENCE).ln();
+    cov.try_inverse()
+        .is_some_and(|inv| (x.transpose() * inv * x)[(0, 0)] > quantile)
+}
 
 /// What the initializer hands to the engine when it can start the filter.
 #[derive(Debug, Clone, PartialEq)]
@@ -32,6 +83,8 @@ pub struct InitialState {
     pub clock_drift_mps: f64,
     pub p: StateMatrix,
     pub heading_from_motion: bool,
+    /// Heading 1-sigma of the start (rad).
+    pub heading_sigma_rad: f64,
 }
 
 /// Progress of the start-up, for diagnostics.
@@ -43,16 +96,58 @@ pub enum InitPhase {
     WaitingForPosition,
     /// Position known; the heading is not (moving too slowly).
     WaitingForHeading,
+    /// Resolving a coarse heading with the bank of hypotheses.
+    AligningHeading,
 }
 
 #[derive(Debug, Clone)]
 struct Leveling {
     t_start_s: f64,
-    /// The newest sample summed.
-    last_t_s: f64,
-    sum_f: Vector3<f64>,
-    sum_w: Vector3<f64>,
-    count: usize,
+    stats: MotionStatistics,
+}
+
+/// A GNSS velocity (ENU) and its horizontal covariance.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct GnssVelocity {
+    t_s: f64,
+    v_enu_mps: Vector3<f64>,
+    cov_h_m2_s2: Matrix2<f64>,
+    /// False for a displacement of fixes not yet significant for [`MOTION_EPOCHS`].
+    confirmed: bool,
+}
+
+impl GnssVelocity {
+    fn speed_h_mps(&self) -> f64 {
+        self.v_enu_mps.xy().norm()
+    }
+
+    /// Moving: the horizontal speed reaches `init.heading_min_speed_mps` and is significant
+    /// against its covariance.
+    fn moving(&self, config: &Config) -> bool {
+        self.confirmed
+            && significant(&self.v_enu_mps.xy(), &self.cov_h_m2_s2)
+            && self.speed_h_mps() >= config.init.heading_min_speed_mps
+    }
+
+    /// 1-sigma of the course (rad): the velocity's spread across its direction over the
+    /// speed.
+    fn course_sigma_rad(&self) -> f64 {
+        let v = self.v_enu_mps.xy();
+        let across = Vector2::new(-v[1], v[0]) / v.norm();
+        (across.transpose() * self.cov_h_m2_s2 * across)[(0, 0)]
+            .max(0.0)
+            .sqrt()
+            / v.norm()
+    }
+}
+
+/// Roll, pitch and heading of an alignment with their 1-sigmas, and the gyro bias.
+#[derive(Debug, Clone, Copy)]
+struct Alignment {
+    q_nb: UnitQuaternion<f64>,
+    /// 1-sigma of roll, pitch and heading (rad).
+    sigma_rad: [f64; 3],
+    velocity_sigma_mps: f64,
 }
 
 #[derive(Debug, Clone)]
@@ -70,9 +165,17 @@ struct Attitude {
 #[derive(Debug, Clone, Default)]
 pub struct Initializer {
     leveling: Option<Leveling>,
+    /// The newest IMU sample seen (a late measurement re-feeds the buffered samples: each
+    /// counts once).
+    last_imu_t_s: Option<f64>,
     attitude: Option<Attitude>,
     position_known: bool,
-    last_fix: Option<GnssFix>,
+    /// The recent fixes (loosely coupled).
+    fixes: FixTrack,
+    /// Consecutive fixes whose displacement was significant.
+    moving_fixes: usize,
+    /// The newest GNSS velocity.
+    velocity: Option<GnssVelocity>,
 }
 
 impl Initializer {
@@ -113,25 +216,25 @@ impl Initializer {
             }
             return;
         }
-        let lev = self.leveling.get_or_insert(Leveling {
-            t_start_s: s.t_s,
-            last_t_s: f64::NEG_INFINITY,
-            sum_f: Vector3::zeros(),
-            sum_w: Vector3::zeros(),
-            count: 0,
-        });
-        // A late measurement re-feeds the buffered samples: each counts once.
-        if s.t_s <= lev.last_t_s {
+        if self.last_imu_t_s.is_some_and(|last| s.t_s <= last) {
             return;
         }
-        lev.last_t_s = s.t_s;
-        lev.sum_f += s.f_ib_b_m_s2;
-        lev.sum_w += s.w_ib_b_rad_s;
-        lev.count += 1;
-        if s.t_s - lev.t_start_s >= config.init.leveling_duration_s && lev.count >= 2 {
-            let n = lev.count as f64;
-            let f = lev.sum_f / n;
-            let w = lev.sum_w / n;
+        self.last_imu_t_s = Some(s.t_s);
+        let lev = self.leveling.get_or_insert(Leveling {
+            t_start_s: s.t_s,
+            stats: MotionStatistics::default(),
+        });
+        lev.stats.push(s);
+        if s.t_s - lev.t_start_s >= config.init.leveling_duration_s && lev.stats.count() >= 2 {
+            let imu_at_rest = lev.stats.at_rest(&config.imu);
+            let gnss_moving = self.velocity.is_some_and(|v| {
+                v.t_s >= lev.t_start_s - SPEED_AGE_S && v.v_enu_mps.norm() > REST_SPEED_MAX_MPS
+            });
+            let (f, w) = (lev.stats.mean_f(), lev.stats.mean_w());
+            self.leveling = None;
+            if !imu_at_rest || gnss_moving {
+                return;
+            }
             // f^b = C_n^b (0, 0, g) at rest: roll = atan2(f_y, f_z),
             // pitch = atan2(−f_x, √(f_y² + f_z²)) (FLU body, REP-103 angles).
             let roll = f[1].atan2(f[2]);
@@ -147,9 +250,14 @@ impl Initializer {
         }
     }
 
-    /// Tries to start from a GNSS epoch (tightly coupled).
-    pub fn try_gnss(&mut self, epoch: &GnssEpoch, config: &Config) -> Option<InitialState> {
-        let attitude = self.attitude.clone()?;
+    /// Tries to start from a GNSS epoch (tightly coupled); `recent` holds the IMU samples
+    /// of the last [`super::standstill::WINDOW_S`] (for an alignment in motion).
+    pub fn try_gnss(
+        &mut self,
+        epoch: &GnssEpoch,
+        config: &Config,
+        recent: &MotionStatistics,
+    ) -> Option<InitialState> {
         let spp_config = SppConfig {
             elevation_mask_rad: config.gnss.elevation_mask_rad,
             sigma: sigma_model(config),
@@ -160,19 +268,36 @@ impl Initializer {
         if sol.num_used < config.init.min_satellites {
             return None;
         }
-        self.position_known = true;
         let velocity = sol.velocity.as_ref().ok();
         let v_enu = velocity.map(|v| v.vel_enu_mps);
-        let (yaw, from_motion) = self.heading(v_enu.as_ref(), config)?;
-        let q_nb = replace_yaw(&attitude.q_nb, yaw);
-        let clock_drift = velocity.map_or(0.0, |v| v.clock_drift_mps);
+        let previous = self.velocity;
+        if let Some(v) = velocity {
+            let r = earth::rot_ecef_to_enu(&sol.pos_llh);
+            let cov: Matrix3<f64> = r * v.covariance.fixed_view::<3, 3>(0, 0) * r.transpose();
+            self.velocity = Some(GnssVelocity {
+                t_s: epoch.t_s,
+                v_enu_mps: v.vel_enu_mps,
+                cov_h_m2_s2: cov.fixed_view::<2, 2>(0, 0).into(),
+                confirmed: true,
+            });
+        }
         let position_var = sol.covariance.fixed_view::<3, 3>(0, 0).trace() / 3.0;
+        let (alignment, from_motion) = match self.attitude.clone() {
+            Some(attitude) => {
+                self.position_known = true;
+                let (yaw, from_motion) = self.heading(v_enu.as_ref(), config)?;
+                let q_nb = replace_yaw(&attitude.q_nb, yaw);
+                let course = self.velocity.filter(|_| from_motion);
+                (Self::levelled(q_nb, course, config), from_motion)
+            }
+            None => (self.align_in_motion(previous, recent, config)?, true),
+        };
+        let clock_drift = velocity.map_or(0.0, |v| v.clock_drift_mps);
         let mut init = self.initial_state(
             epoch.t_s,
             &sol.pos_llh,
             v_enu.unwrap_or_else(Vector3::zeros),
-            q_nb,
-            &attitude,
+            &alignment,
             config,
             position_var,
         );
@@ -189,34 +314,171 @@ impl Initializer {
     }
 
     /// Tries to start from a receiver fix (loosely coupled). Without a velocity in the fix,
-    /// the velocity comes from the difference of consecutive fixes.
-    pub fn try_fix(&mut self, fix: &GnssFix, config: &Config) -> Option<InitialState> {
-        let previous = self.last_fix.replace(fix.clone());
-        let attitude = self.attitude.clone()?;
-        self.position_known = true;
-        let velocity = fix.velocity_enu_mps.or_else(|| {
-            let prev = previous?;
-            let dt = fix.t_s - prev.t_s;
-            (dt > 0.0 && dt < 5.0).then(|| earth::llh_to_enu(&fix.position, &prev.position) / dt)
-        });
-        let (yaw, from_motion) = self.heading(velocity.as_ref(), config)?;
-        let q_nb = replace_yaw(&attitude.q_nb, yaw);
-        let position_var = fix
+    /// the velocity comes from the displacement of the recent fixes (see the module
+    /// documentation).
+    pub fn try_fix(
+        &mut self,
+        fix: &GnssFix,
+        config: &Config,
+        recent: &MotionStatistics,
+    ) -> Option<InitialState> {
+        let previous = self.velocity;
+        let fix_var = fix
             .position_covariance_enu_m2
             .map_or(config.loose.fix_sigma_horizontal_m.powi(2), |c| {
                 c.trace() / 3.0
             });
+        let (velocity, position, position_var) = match fix.velocity_enu_mps {
+            Some(v) => {
+                let cov = super::update::velocity_covariance(fix, config);
+                let velocity = GnssVelocity {
+                    t_s: fix.t_s,
+                    v_enu_mps: v,
+                    cov_h_m2_s2: cov.fixed_view::<2, 2>(0, 0).into(),
+                    confirmed: true,
+                };
+                (Some(velocity), fix.position, fix_var)
+            }
+            None => match self.track_velocity(fix, recent, config) {
+                Some((velocity, position, var)) => (Some(velocity), position, var),
+                None => (None, fix.position, fix_var),
+            },
+        };
+        if velocity.is_some() {
+            self.velocity = velocity;
+        }
+        let (alignment, from_motion) = match self.attitude.clone() {
+            Some(attitude) => {
+                self.position_known = true;
+                let v = velocity.filter(|v| fix.velocity_enu_mps.is_some() || v.moving(config));
+                let (yaw, from_motion) = self.heading(v.map(|v| v.v_enu_mps).as_ref(), config)?;
+                let q_nb = replace_yaw(&attitude.q_nb, yaw);
+                (
+                    Self::levelled(q_nb, v.filter(|_| from_motion), config),
+                    from_motion,
+                )
+            }
+            None => (self.align_in_motion(previous, recent, config)?, true),
+        };
         let mut init = self.initial_state(
             fix.t_s,
-            &fix.position,
-            velocity.unwrap_or_else(Vector3::zeros),
-            q_nb,
-            &attitude,
+            &position,
+            self.velocity.map_or_else(Vector3::zeros, |v| v.v_enu_mps),
+            &alignment,
             config,
             position_var,
         );
         init.heading_from_motion = from_motion;
         Some(init)
+    }
+
+    /// The velocity of the line through the recent fixes ([`FixTrack`]), turned on by the
+    /// rate about the vertical over its lag (a turn's course has moved on), and the line's
+    /// position and its variance at the newest fix; confirmed once the velocity has been
+    /// significant for [`MOTION_EPOCHS`] consecutive fixes.
+    fn track_velocity(
+        &mut self,
+        fix: &GnssFix,
+        recent: &MotionStatistics,
+        config: &Config,
+    ) -> Option<(GnssVelocity, Llh, f64)> {
+        self.fixes.push(fix);
+        let fit = self.fixes.fit(config)?;
+        let v_h = fit.v_enu_mps.xy();
+        self.moving_fixes = if significant(&v_h, &fit.cov_v_h_m2_s2) {
+            self.moving_fixes + 1
+        } else {
+            0
+        };
+        let up = recent
+            .mean_f()
+            .try_normalize(1e-9)
+            .unwrap_or_else(Vector3::z);
+        let rotation = nalgebra::Rotation2::new(recent.mean_w().dot(&up) * fit.lag_s);
+        let v_h = rotation * v_h;
+        let velocity = GnssVelocity {
+            t_s: fit.t_s,
+            v_enu_mps: Vector3::new(v_h[0], v_h[1], fit.v_enu_mps[2]),
+            cov_h_m2_s2: rotation.matrix() * fit.cov_v_h_m2_s2 * rotation.matrix().transpose(),
+            confirmed: self.moving_fixes >= MOTION_EPOCHS,
+        };
+        Some((velocity, fit.position, fit.position_var_m2))
+    }
+
+    /// The levelled attitude turned to the heading found, with the configured 1-sigmas; a
+    /// heading from the `course` of a GNSS velocity has at least the course's own
+    /// uncertainty and [`COURSE_SIGMA_RAD`].
+    fn levelled(
+        q_nb: UnitQuaternion<f64>,
+        course: Option<GnssVelocity>,
+        config: &Config,
+    ) -> Alignment {
+        let i = &config.init;
+        let heading_sigma = course.map_or(i.heading_sigma_rad, |v| {
+            i.heading_sigma_rad
+                .max(v.course_sigma_rad().hypot(COURSE_SIGMA_RAD))
+        });
+        Alignment {
+            q_nb,
+            sigma_rad: [i.attitude_sigma_rad, i.attitude_sigma_rad, heading_sigma],
+            velocity_sigma_mps: i.velocity_sigma_mps,
+        }
+    }
+
+    /// Roll, pitch and heading of a moving platform from the newest GNSS velocity and the
+    /// `recent` IMU samples (see the module documentation); None while not moving.
+    fn align_in_motion(
+        &self,
+        previous: Option<GnssVelocity>,
+        recent: &MotionStatistics,
+        config: &Config,
+    ) -> Option<Alignment> {
+        let v = self.velocity.filter(|v| v.moving(config))?;
+        if recent.count() < 2 {
+            return None;
+        }
+        let speed = v.v_enu_mps.norm();
+        let speed_sigma = v.cov_h_m2_s2.trace().max(0.0).sqrt();
+        // The forward acceleration from the previous GNSS speed, when that is close enough
+        // in time and precise enough to beat the unknown acceleration.
+        let (accel, accel_sigma) = previous
+            .filter(|p| p.confirmed && p.t_s < v.t_s && v.t_s - p.t_s <= SPEED_AGE_S)
+            .map(|p| {
+                let dt = v.t_s - p.t_s;
+                let sigma = (v.cov_h_m2_s2.trace() + p.cov_h_m2_s2.trace())
+                    .max(0.0)
+                    .sqrt()
+                    / dt;
+                ((speed - p.v_enu_mps.norm()) / dt, sigma)
+            })
+            .filter(|(_, sigma)| *sigma < UNKNOWN_ACCELERATION_M_S2)
+            .unwrap_or((0.0, UNKNOWN_ACCELERATION_M_S2));
+        // The body's acceleration with its velocity along x: d/dt (s, 0, 0) + ω × (s, 0, 0).
+        let w = recent.mean_w();
+        let a_b = Vector3::new(accel, w[2] * speed, -w[1] * speed);
+        let up = recent.mean_f() - a_b;
+        let roll = up[1].atan2(up[2]);
+        let pitch = (-up[0]).atan2(up[1].hypot(up[2]));
+        let yaw = match config.init.heading_rad {
+            Some(heading) => enu_yaw_of_heading(heading),
+            None => v.v_enu_mps[1].atan2(v.v_enu_mps[0]),
+        };
+        let g = up.norm().max(1.0);
+        let i = &config.init;
+        let sideways = config.imu.gyro_bias_sigma_rad_s * speed;
+        let heading_sigma = match config.init.heading_rad {
+            Some(_) => i.heading_sigma_rad,
+            None => v.course_sigma_rad().hypot(COURSE_SIGMA_RAD),
+        };
+        Some(Alignment {
+            q_nb: UnitQuaternion::from_euler_angles(roll, pitch, yaw),
+            sigma_rad: [
+                i.attitude_sigma_rad.hypot(sideways / g),
+                i.attitude_sigma_rad.hypot(accel_sigma / g),
+                heading_sigma,
+            ],
+            velocity_sigma_mps: i.velocity_sigma_mps.max(speed_sigma),
+        })
     }
 
     /// Heading (ENU yaw, rad) and whether it came from motion; None while unknown.
@@ -228,17 +490,16 @@ impl Initializer {
         (v[0].hypot(v[1]) >= config.init.heading_min_speed_mps).then(|| (v[1].atan2(v[0]), true))
     }
 
-    #[allow(clippy::too_many_arguments)]
     fn initial_state(
         &self,
         t_s: f64,
         antenna: &Llh,
         v_enu: Vector3<f64>,
-        q_nb: UnitQuaternion<f64>,
-        attitude: &Attitude,
+        alignment: &Alignment,
         config: &Config,
         position_var_m2: f64,
     ) -> InitialState {
+        let q_nb = alignment.q_nb;
         // The solution is the antenna's: move it to the IMU by the lever arm.
         let lever_n = q_nb * config.mounting.lever_arm_b_m;
         let imu_ecef =
@@ -252,14 +513,13 @@ impl Initializer {
         };
         let mut cov = StateMatrix::zeros();
         let i = &config.init;
-        let att = i.attitude_sigma_rad.powi(2);
         let set3 = |cov: &mut StateMatrix, start: usize, v: [f64; 3]| {
             for (k, value) in v.iter().enumerate() {
                 cov[(start + k, start + k)] = *value;
             }
         };
-        set3(&mut cov, PHI, [att, att, i.heading_sigma_rad.powi(2)]);
-        let vel = i.velocity_sigma_mps.powi(2);
+        set3(&mut cov, PHI, alignment.sigma_rad.map(|s| s.powi(2)));
+        let vel = alignment.velocity_sigma_mps.powi(2);
         set3(&mut cov, DV, [vel, vel, vel]);
         let pos = i.position_sigma_m.powi(2).max(position_var_m2);
         let (north, east) = earth::metres_per_radian(&p);
@@ -268,7 +528,19 @@ impl Initializer {
             DP,
             [pos / (north * north), pos / (east * east), pos],
         );
-        let gb = config.imu.gyro_bias_sigma_rad_s.powi(2);
+        // Choice: a bias measured at rest is known to the rate noise's mean over the
+        // levelling window and the in-run drift; the class's turn-on σ applies otherwise.
+        let levelled_s = self
+            .attitude
+            .as_ref()
+            .and_then(|a| a.at_rest.map(|_| config.init.leveling_duration_s));
+        let gb = levelled_s.map_or(config.imu.gyro_bias_sigma_rad_s, |t| {
+            let measured = (config.imu.gyro_arw_rad_per_sqrt_s.powi(2) / t
+                + config.imu.gyro_markov_sigma_rad_s.powi(2))
+            .sqrt();
+            config.imu.gyro_bias_sigma_rad_s.min(measured)
+        });
+        let gb = gb.powi(2);
         set3(&mut cov, GYRO_BIAS, [gb, gb, gb]);
         let gm = config.imu.gyro_markov_sigma_rad_s.powi(2);
         set3(&mut cov, GYRO_GM, [gm, gm, gm]);
@@ -277,15 +549,21 @@ impl Initializer {
         cov[(CLOCK_BIAS, CLOCK_BIAS)] = i.clock_bias_sigma_m.powi(2);
         cov[(CLOCK_DRIFT, CLOCK_DRIFT)] = i.clock_drift_sigma_mps.powi(2);
         // The bias at rest is the mean rate less the earth rate seen in the body frame,
-        // which needs the heading: the levelled attitude turned by the yaw found since.
-        let gyro_bias_rad_s =
-            attitude
-                .at_rest
-                .map_or(attitude.gyro_bias_rad_s, |(q_level, w_rest)| {
-                    let yaw_offset = q_nb.euler_angles().2 - attitude.q_nb.euler_angles().2;
-                    let q_rest = UnitQuaternion::from_euler_angles(0.0, 0.0, yaw_offset) * q_level;
-                    w_rest - q_rest.inverse() * earth::earth_rate_enu_rad_s(p.lat_rad)
-                });
+        // which needs the heading: the levelled attitude turned by the yaw found since. An
+        // alignment in motion has no bias (zero, with the class's σ above).
+        let gyro_bias_rad_s = self
+            .attitude
+            .as_ref()
+            .map_or_else(Vector3::zeros, |attitude| {
+                attitude
+                    .at_rest
+                    .map_or(attitude.gyro_bias_rad_s, |(q_level, w_rest)| {
+                        let yaw_offset = q_nb.euler_angles().2 - attitude.q_nb.euler_angles().2;
+                        let q_rest =
+                            UnitQuaternion::from_euler_angles(0.0, 0.0, yaw_offset) * q_level;
+                        w_rest - q_rest.inverse() * earth::earth_rate_enu_rad_s(p.lat_rad)
+                    })
+            });
         InitialState {
             nav,
             gyro_bias_rad_s,
@@ -293,6 +571,7 @@ impl Initializer {
             clock_drift_mps: 0.0,
             p: cov,
             heading_from_motion: false,
+            heading_sigma_rad: alignment.sigma_rad[2],
         }
     }
 }

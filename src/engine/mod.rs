@@ -17,15 +17,26 @@
 //! - A measurement older than the last IMU sample (late delivery) rolls the filter back to
 //!   the last stored state before it, applies it, and re-integrates the buffered IMU
 //!   samples; one older than `engine.imu_buffer_s` is rejected and counted.
+//! - Start-up (`initializer`): levelled at rest, or aligned in motion from GNSS when
+//!   the IMU's window is not at rest (a start or a restart mid-drive); a start whose
+//!   heading is too uncertain for one filter runs a bank of heading hypotheses first
+//!   ([`heading_bank`]), and nothing is published until it has decided.
+//! - IMU samples are screened first ([`imu_screen`]): one beyond the sensor's range or a
+//!   lone spike is dropped and counted, and the strapdown step spans it.
 
 mod adaptation;
 pub mod adaptive_noise;
 mod filter_state;
+mod fix_track;
+pub mod heading_bank;
+pub mod imu_screen;
 mod initializer;
 mod output;
 pub mod q_scaling;
 mod rejection;
 mod retune;
+pub mod standstill;
+mod start_up;
 pub mod update;
 
 use std::collections::VecDeque;
@@ -34,6 +45,10 @@ use crate::config::{Config, Coupling};
 use crate::filter::process_model::ProcessNoise;
 use crate::gnss::GnssEpoch;
 use crate::ins::ImuSample;
+
+use heading_bank::HeadingBank;
+use imu_screen::{ImuScreen, Screened};
+use standstill::StandstillDetector;
 
 pub use adaptation::Adaptation;
 pub use filter_state::{interpolate, FilterState};
@@ -79,6 +94,8 @@ struct Snapshot {
 #[derive(Debug, Clone)]
 enum Phase {
     Initializing(Box<Initializer>),
+    /// Resolving a coarse heading with a bank of hypotheses.
+    Aligning(Box<HeadingBank>),
     Running(Box<FilterState>),
 }
 
@@ -103,6 +120,10 @@ pub struct Engine {
     /// re-integrated after a roll-back use the scale of now; the estimators learn only from
     /// measurements seen for the first time.
     adaptation: Adaptation,
+    /// The IMU samples' screen (range and spikes).
+    screen: ImuScreen,
+    /// The recent body-frame samples, for the start-up's tests of rest and motion.
+    standstill: StandstillDetector,
 }
 
 impl Engine {
@@ -110,6 +131,7 @@ impl Engine {
         let process_noise = process_noise(&config);
         Self {
             adaptation: Adaptation::new(&config),
+            standstill: StandstillDetector::default(),
             config,
             process_noise,
             phase: Phase::Initializing(Box::default()),
@@ -119,6 +141,7 @@ impl Engine {
             last_output_t_s: f64::NEG_INFINITY,
             counters: RejectionCounters::default(),
             replaying: false,
+            screen: ImuScreen::default(),
         }
     }
 
@@ -135,7 +158,7 @@ impl Engine {
     pub fn state(&self) -> Option<&FilterState> {
         match &self.phase {
             Phase::Running(s) => Some(s),
-            Phase::Initializing(_) => None,
+            Phase::Initializing(_) | Phase::Aligning(_) => None,
         }
     }
 
@@ -143,6 +166,7 @@ impl Engine {
     pub fn init_phase(&self) -> Option<InitPhase> {
         match &self.phase {
             Phase::Initializing(init) => Some(init.phase()),
+            Phase::Aligning(_) => Some(InitPhase::AligningHeading),
             Phase::Running(_) => None,
         }
     }
@@ -171,7 +195,7 @@ impl Engine {
                 s.gyro_bias_rad_s + s.gyro_markov_rad_s,
                 s.last_imu.t_s,
             )),
-            Phase::Initializing(_) => Box::default(),
+            Phase::Initializing(_) | Phase::Aligning(_) => Box::default(),
         };
         self.phase = Phase::Initializing(init);
         self.adaptation.reset();
@@ -207,11 +231,28 @@ impl Engine {
                     .counters
                     .reject(RejectionReason::ImuOutOfOrder, body.t_s));
             }
-            if dt > self.config.engine.max_imu_gap_s {
+        }
+        match self.screen.screen(sample, &self.config.imu) {
+            Screened::Kept => {}
+            Screened::OutOfRange => {
+                return Err(self
+                    .counters
+                    .reject(RejectionReason::ImuOutOfRange, body.t_s))
+            }
+            Screened::Spike => {
+                return Err(self
+                    .counters
+                    .reject(RejectionReason::ImuInconsistent, body.t_s))
+            }
+        }
+        if let Some(last) = self.imu.back() {
+            if body.t_s - last.t_s > self.config.engine.max_imu_gap_s {
                 self.counters.reject(RejectionReason::ImuGap, body.t_s);
+                self.standstill.clear();
                 out.push(self.reset(body.t_s, ResetReason::ImuGap));
             }
         }
+        self.standstill.push(&body);
         self.imu.push_back(body);
         let horizon = body.t_s - self.config.engine.imu_buffer_s;
         while self.imu.front().is_some_and(|s| s.t_s < horizon) && self.imu.len() > 2 {
@@ -288,7 +329,7 @@ impl Engine {
         }
         let mut out = Vec::new();
         match &self.phase {
-            Phase::Initializing(_) => {
+            Phase::Initializing(_) | Phase::Aligning(_) => {
                 // Start-up needs no exact alignment: try it now, then re-integrate.
                 self.enqueue(m, false);
                 self.replay_from(None, &mut out);
@@ -363,6 +404,19 @@ impl Engine {
         }
         match &mut self.phase {
             Phase::Initializing(init) => init.push_imu(s, &self.config),
+            Phase::Aligning(bank) => {
+                if bank.last_imu_t_s() < s.t_s {
+                    if let Err(e) = bank.propagate(s, &self.process_noise) {
+                        log::warn!(
+                            "IMU step of the heading bank to t = {:.6} s failed: {e}",
+                            s.t_s
+                        );
+                        self.counters.reject(RejectionReason::ImuStepFailed, s.t_s);
+                        let reset = self.reset(s.t_s, ResetReason::Diverged);
+                        out.push(reset);
+                    }
+                }
+            }
             Phase::Running(state) => {
                 if state.last_imu.t_s < s.t_s {
                     let noise = self.process_noise.scaled(self.adaptation.q.scale());
@@ -387,40 +441,8 @@ impl Engine {
         let t = p.measurement.t_s();
         let report = !p.reported;
         match &mut self.phase {
-            Phase::Initializing(init) => {
-                let started = match &p.measurement {
-                    Measurement::Gnss(e) => init.try_gnss(e, &self.config),
-                    Measurement::Fix(f) => init.try_fix(f, &self.config),
-                };
-                if let Some(initial) = started {
-                    let before = self
-                        .imu
-                        .iter()
-                        .rev()
-                        .find(|s| s.t_s <= t)
-                        .copied()
-                        .unwrap_or(*next);
-                    let last_imu = interpolate(&before, next, t);
-                    let state = FilterState {
-                        nav: initial.nav,
-                        gyro_bias_rad_s: initial.gyro_bias_rad_s,
-                        gyro_markov_rad_s: nalgebra::Vector3::zeros(),
-                        accel_bias_m_s2: nalgebra::Vector3::zeros(),
-                        clock_bias_m: initial.clock_bias_m,
-                        clock_drift_mps: initial.clock_drift_mps,
-                        p: initial.p,
-                        prev_increment: None,
-                        last_imu,
-                    };
-                    self.phase = Phase::Running(Box::new(state));
-                    if report {
-                        out.push(Output::Status(StatusEvent::Initialized {
-                            t_s: t,
-                            heading_from_motion: initial.heading_from_motion,
-                        }));
-                    }
-                }
-            }
+            Phase::Initializing(_) => self.try_start(&p.measurement, next, report, out),
+            Phase::Aligning(_) => self.update_bank(&p.measurement, next, report, out),
             Phase::Running(state) => {
                 if state.last_imu.t_s < t {
                     let at_t = interpolate(&state.last_imu, next, t);

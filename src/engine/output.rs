@@ -163,6 +163,13 @@ pub struct EpochReport {
     pub measurements_used: usize,
     /// Normalized innovation squared of the update (NaN without an update).
     pub nis: f64,
+    /// νᵀ(H P⁻ Hᵀ + R)⁻¹ν with the prior and the noise strategy's R before any robust
+    /// inflation or adaptive factor (NaN without an update; equal to `nis` for the plain
+    /// filters).
+    pub prior_nis: f64,
+    /// ln det(H P⁻ Hᵀ + R) of the same matrix (NaN without an update): with `prior_nis`,
+    /// the measurement's log-likelihood (what the heading bank scores).
+    pub prior_log_det_s: f64,
     /// A receiver clock jump absorbed in this epoch (m), 0 if none.
     pub clock_jump_m: f64,
     /// Adaptive factor α of an adaptive scheme (NaN: none).
@@ -189,6 +196,8 @@ impl EpochReport {
             satellites: Vec::new(),
             measurements_used: 0,
             nis: f64::NAN,
+            prior_nis: f64::NAN,
+            prior_log_det_s: f64::NAN,
             clock_jump_m: 0.0,
             adaptive_factor: f64::NAN,
             mahalanobis_d2: f64::NAN,

@@ -15,6 +15,12 @@ pub enum RejectionReason {
     ImuGap,
     /// The strapdown step failed (non-finite result).
     ImuStepFailed,
+    /// An IMU axis beyond the sensor's range (`imu.gyro_range_deg_per_s`,
+    /// `imu.accel_range_g`).
+    ImuOutOfRange,
+    /// An IMU sample jumping from its neighbours beyond what the signal can change
+    /// (`imu.gyro_max_step_deg_per_s`, `imu.accel_max_step_g`).
+    ImuInconsistent,
     /// The GNSS epoch's time is NaN or infinite.
     GnssNotFinite,
     /// A GNSS epoch with no satellites.
@@ -40,6 +46,8 @@ impl RejectionReason {
             Self::ImuOutOfOrder => "imu_out_of_order",
             Self::ImuGap => "imu_gap",
             Self::ImuStepFailed => "imu_step_failed",
+            Self::ImuOutOfRange => "imu_out_of_range",
+            Self::ImuInconsistent => "imu_inconsistent",
             Self::GnssNotFinite => "gnss_not_finite",
             Self::GnssNoSatellites => "gnss_no_satellites",
             Self::FixNotFinite => "fix_not_finite",

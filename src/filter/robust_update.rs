@@ -118,6 +118,10 @@ pub struct UpdateOutcome {
     pub r: DMatrix<f64>,
     /// νᵀ S⁻¹ ν with the S of the gain.
     pub nis: f64,
+    /// νᵀ S₀⁻¹ ν and ln det S₀ with S₀ = H P⁻ Hᵀ + R, the un-inflated prior and the noise
+    /// strategy's R (equal to `nis` and the gain's S without a scheme).
+    pub prior_nis: f64,
+    pub prior_log_det_s: f64,
     /// Adaptive factor α applied (NaN: no adaptive scheme).
     pub adaptive_factor: f64,
     /// M² of the nominal innovation covariance (NaN: not tested).
@@ -168,12 +172,15 @@ impl RobustUpdate {
         }
         let nominal = self.moments(&prior, set, &set.r)?;
         let hph = symmetrize(&(&nominal.s - &set.r));
+        let (prior_nis, prior_log_det_s) = normalized_squared(&nominal.innovation, &nominal.s);
         let mut outcome = UpdateOutcome {
             innovation: nominal.innovation.clone(),
             s: nominal.s.clone(),
             hph,
             r: set.r.clone(),
             nis: f64::NAN,
+            prior_nis,
+            prior_log_det_s,
             adaptive_factor: f64::NAN,
             mahalanobis_d2: f64::NAN,
             chi2_threshold: f64::NAN,
@@ -255,12 +262,15 @@ impl RobustUpdate {
     fn plain_ekf(&self, p: &StateMatrix, set: &MeasurementSet) -> Result<Correction, FilterError> {
         let result = ekf::update(p, &set.h, &set.y, &set.r, self.joseph)?;
         let m = set.y.len();
+        let (_, prior_log_det_s) = normalized_squared(&set.y, &result.s);
         let outcome = UpdateOutcome {
             innovation: set.y.clone(),
             hph: symmetrize(&(&result.s - &set.r)),
             s: result.s,
             r: set.r.clone(),
             nis: result.nis,
+            prior_nis: result.nis,
+            prior_log_det_s,
             adaptive_factor: f64::NAN,
             mahalanobis_d2: f64::NAN,
             chi2_threshold: f64::NAN,
@@ -312,6 +322,17 @@ impl RobustUpdate {
             pxz: u.cross_covariance,
         })
     }
+}
+
+/// νᵀ S⁻¹ ν and ln det S of an innovation and its covariance; NaN when S has no factor
+/// (they are diagnostics: the update itself reports its own failures).
+fn normalized_squared(innovation: &DVector<f64>, s: &DMatrix<f64>) -> (f64, f64) {
+    SpdFactor::new("innovation covariance", s).map_or((f64::NAN, f64::NAN), |factor| {
+        (
+            innovation.dot(&factor.solve_vector(innovation)),
+            factor.log_det(),
+        )
+    })
 }
 
 /// The prior covariance as the cubature rule needs it: `p` itself when its Cholesky factor

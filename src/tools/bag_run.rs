@@ -86,6 +86,8 @@ impl BagRun {
             RejectionReason::ImuNotFinite,
             RejectionReason::ImuDuplicate,
             RejectionReason::ImuOutOfOrder,
+            RejectionReason::ImuOutOfRange,
+            RejectionReason::ImuInconsistent,
         ]
         .into_iter()
         .map(|r| self.rejections.count(r))

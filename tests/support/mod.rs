@@ -3,6 +3,7 @@
 #![allow(dead_code)]
 
 pub mod drive;
+pub mod fixes;
 
 use adaptive_gnss_ins::config::Config;
 use adaptive_gnss_ins::earth::{self, Llh};

@@ -142,7 +142,7 @@ impl MeasurementModel for FixMeasurement<'_> {
 
 /// The position covariance the update uses: the fix's own when configured and valid
 /// (symmetric positive definite), else the configured diagonal.
-fn position_covariance(fix: &GnssFix, config: &Config) -> Matrix3<f64> {
+pub(crate) fn position_covariance(fix: &GnssFix, config: &Config) -> Matrix3<f64> {
     let configured = Matrix3::from_diagonal(&Vector3::new(
         config.loose.fix_sigma_horizontal_m.powi(2),
         config.loose.fix_sigma_horizontal_m.powi(2),
@@ -156,7 +156,8 @@ fn position_covariance(fix: &GnssFix, config: &Config) -> Matrix3<f64> {
     }
 }
 
-fn velocity_covariance(fix: &GnssFix, config: &Config) -> Matrix3<f64> {
+/// The velocity covariance the update uses (as [`position_covariance`]).
+pub(crate) fn velocity_covariance(fix: &GnssFix, config: &Config) -> Matrix3<f64> {
     let configured = Matrix3::identity() * config.loose.velocity_sigma_mps.powi(2);
     match fix.velocity_covariance_enu_m2_s2 {
         Some(c) if config.loose.use_fix_covariance && c.cholesky().is_some() => {

@@ -50,6 +50,7 @@ use super::filter_state::FilterState;
 use super::output::EpochReport;
 use gate::{gate, GateRow};
 
+pub(crate) use fix::{position_covariance, velocity_covariance};
 pub use fix::{FixMeasurement, GnssFix};
 pub use model::{Linearization, MeasurementModel, NoiseChannel, NominalNoise};
 pub use pseudoranges::{sigma_model, Pseudoranges};
@@ -221,6 +222,8 @@ impl<M: MeasurementModel> Step<'_, M> {
         self.model.report_update(report, &rows.indices, outcome);
         report.measurements_used = rows.indices.len();
         report.nis = outcome.nis;
+        report.prior_nis = outcome.prior_nis;
+        report.prior_log_det_s = outcome.prior_log_det_s;
         report.adaptive_factor = outcome.adaptive_factor;
         report.mahalanobis_d2 = outcome.mahalanobis_d2;
         report.chi2_threshold = outcome.chi2_threshold;

@@ -1,0 +1,125 @@
+//! The engine's start-up steps: a GNSS measurement handed to the initializer, and to the
+//! bank of heading hypotheses when the start's heading is too uncertain for one filter.
+
+use nalgebra::Vector3;
+
+use super::filter_state::{interpolate, FilterState};
+use super::heading_bank::{self, HeadingBank};
+use super::initializer::InitialState;
+use super::update;
+use super::{Engine, Measurement, Output, Phase, StatusEvent};
+use crate::ins::ImuSample;
+
+impl Engine {
+    /// Tries to start from the GNSS measurement `m` (the sample after it is `next`); on
+    /// success the filter runs, or the heading bank does.
+    pub(super) fn try_start(
+        &mut self,
+        m: &Measurement,
+        next: &ImuSample,
+        report: bool,
+        out: &mut Vec<Output>,
+    ) {
+        let Phase::Initializing(init) = &mut self.phase else {
+            return;
+        };
+        let recent = self.standstill.window();
+        let started = match m {
+            Measurement::Gnss(e) => init.try_gnss(e, &self.config, &recent),
+            Measurement::Fix(f) => init.try_fix(f, &self.config, &recent),
+        };
+        let Some(initial) = started else {
+            return;
+        };
+        let t = m.t_s();
+        let state = self.initial_filter_state(&initial, t, next);
+        if initial.heading_sigma_rad > heading_bank::BANK_ABOVE_RAD {
+            self.phase = Phase::Aligning(Box::new(HeadingBank::new(
+                &state,
+                initial.heading_sigma_rad,
+                &self.config,
+            )));
+            return;
+        }
+        self.start_running(state, initial.heading_from_motion, report, out);
+    }
+
+    /// The filter state of a start at `t` (between the buffered samples and `next`).
+    fn initial_filter_state(
+        &self,
+        initial: &InitialState,
+        t: f64,
+        next: &ImuSample,
+    ) -> FilterState {
+        let before = self
+            .imu
+            .iter()
+            .rev()
+            .find(|s| s.t_s <= t)
+            .copied()
+            .unwrap_or(*next);
+        FilterState {
+            nav: initial.nav,
+            gyro_bias_rad_s: initial.gyro_bias_rad_s,
+            gyro_markov_rad_s: Vector3::zeros(),
+            accel_bias_m_s2: Vector3::zeros(),
+            clock_bias_m: initial.clock_bias_m,
+            clock_drift_mps: initial.clock_drift_mps,
+            p: initial.p,
+            prev_increment: None,
+            last_imu: interpolate(&before, next, t),
+        }
+    }
+
+    fn start_running(
+        &mut self,
+        state: FilterState,
+        heading_from_motion: bool,
+        report: bool,
+        out: &mut Vec<Output>,
+    ) {
+        let t_s = state.nav.t_s;
+        self.phase = Phase::Running(Box::new(state));
+        if report {
+            out.push(Output::Status(StatusEvent::Initialized {
+                t_s,
+                heading_from_motion,
+            }));
+        }
+    }
+
+    /// Updates every hypothesis of the heading bank with `m`; starts the filter once the
+    /// bank has decided.
+    pub(super) fn update_bank(
+        &mut self,
+        m: &Measurement,
+        next: &ImuSample,
+        report: bool,
+        out: &mut Vec<Output>,
+    ) {
+        let Phase::Aligning(bank) = &mut self.phase else {
+            return;
+        };
+        let t = m.t_s();
+        bank.update(t, next, &self.process_noise, |state, adaptation, config| {
+            let w = state.compensate(&state.last_imu).w_ib_b_rad_s;
+            match m {
+                Measurement::Gnss(e) => {
+                    let mut model = update::Pseudoranges::new(e, &w, config);
+                    update::apply(state, &mut model, adaptation, true)
+                }
+                Measurement::Fix(f) => {
+                    let mut model = update::FixMeasurement::new(f, &w, config, state);
+                    update::apply(state, &mut model, adaptation, true)
+                }
+            }
+        });
+        if bank.is_empty() {
+            self.phase = Phase::Initializing(Box::default());
+            return;
+        }
+        if let Some(state) = bank.resolved(t) {
+            self.start_running(state, true, report, out);
+        }
+    }
+}
