@@ -514,3 +514,73 @@ fn a_sustained_time_jump_resets_once_and_loses_no_sample() {
     );
 }
 
+#[test]
+fn a_flood_of_imu_samples_and_far_future_measurements_keep_the_buffers_bounded() {
+    use crate::engine::{MAX_BUFFERED_IMU_SAMPLES, MAX_PENDING_MEASUREMENTS};
+    use crate::sim::SimEvent;
+    // Issue 12, item 12: stamps 1 µs apart, and a fix 1000 s ahead, grew memory for good.
+    let mut adapter = loose_adapter(OutputFrames::default());
+    let mut last = None;
+    let mut fix = None;
+    for_each_static_event_30_s(|event, stamp| match event {
+        SimEvent::Imu(s) => {
+            adapter.on_imu(&outbound::imu(&s, stamp, "imu"));
+            last = Some(s);
+        }
+        SimEvent::Fix(f) => {
+            adapter.on_fix(&outbound::receiver_fix(&f, stamp, "gnss"));
+            fix = Some(f);
+        }
+        _ => {}
+    });
+    assert_eq!(adapter.engine().init_phase(), None, "running");
+    let (last, mut fix) = (last.unwrap(), fix.unwrap());
+    let t0_s = last.t_s;
+    let mut most = adapter.engine().buffered();
+    for k in 1..=100_000u32 {
+        let t_s = t0_s + 1e-6 * f64::from(k);
+        adapter.on_imu(&imu_message(&last, t_s, "imu"));
+        if k % 1000 == 0 {
+            // A fix stamped 1000 s ahead: rejected, never queued.
+            fix.t_s = t_s + 1000.0;
+            let stamp = seconds_to_time(fix.t_s).unwrap();
+            adapter.on_fix(&outbound::receiver_fix(&fix, stamp, "gnss"));
+            let b = adapter.engine().buffered();
+            most.imu_samples = most.imu_samples.max(b.imu_samples);
+            most.states = most.states.max(b.states);
+            most.measurements = most.measurements.max(b.measurements);
+        }
+    }
+    assert_eq!(
+        adapter.engine().last_imu_t_s(),
+        Some(t0_s + 1e-6 * 100_000.0)
+    );
+    assert_eq!(adapter.engine().init_phase(), None, "still running");
+    assert_eq!(most.imu_samples, MAX_BUFFERED_IMU_SAMPLES);
+    assert_eq!(most.states, MAX_BUFFERED_IMU_SAMPLES);
+    assert!(most.measurements <= 1, "{most:?}");
+    let counters = adapter.engine().counters();
+    assert_eq!(counters.count(RejectionReason::MeasurementTooNew), 100);
+    assert_eq!(
+        diagnostic(&adapter, "rejected_measurement_too_new").as_deref(),
+        Some("100")
+    );
+    // Without any IMU, measurements wait; the queue keeps the newest.
+    let mut adapter = loose_adapter(OutputFrames::default());
+    for k in 0..3 * MAX_PENDING_MEASUREMENTS {
+        fix.t_s = 10.0 + k as f64;
+        let stamp = seconds_to_time(fix.t_s).unwrap();
+        adapter.on_fix(&outbound::receiver_fix(&fix, stamp, "gnss"));
+    }
+    assert_eq!(
+        adapter.engine().buffered().measurements,
+        MAX_PENDING_MEASUREMENTS
+    );
+    assert_eq!(
+        adapter
+            .engine()
+            .counters()
+            .count(RejectionReason::MeasurementQueueFull),
+        2 * MAX_PENDING_MEASUREMENTS as u64
+    );
+}
