@@ -68,8 +68,8 @@ impl RosAdapter {
             Verdict::OnLine => self.feed_imu(&sample, frame_id, &mut outputs),
             Verdict::Held => {}
             Verdict::Jumped(run) => {
-                let (from_t_s, to_t_s) = (last_t_s.unwrap_or_default(), run[0].t_s);
-                if to_t_s < from_t_s {
+                let to_t_s = run.first().map_or(f64::NAN, |s| s.t_s);
+                if let Some(from_t_s) = last_t_s.filter(|&from_t_s| to_t_s < from_t_s) {
                     self.counts.time_jump_resets += 1;
                     self.log.warn(
                         "time jump",
@@ -95,7 +95,11 @@ impl RosAdapter {
         match self.engine.push_imu(sample) {
             Ok(o) => {
                 self.imu_frame.accepted(frame_id);
-                outputs.extend(o);
+                if outputs.is_empty() {
+                    *outputs = o;
+                } else {
+                    outputs.extend(o);
+                }
             }
             Err(e) => {
                 self.log.warn(e.reason.name(), &format!("imu: {e}"));
