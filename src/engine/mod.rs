@@ -55,8 +55,8 @@ pub use update::GnssFix;
 /// Choice: 10,000: 10 s of a 1 kHz IMU, the default 2 s of a 5 kHz one. Samples stamped
 /// microseconds apart (a flood, a broken clock) would otherwise fill the time window with
 /// millions of states; with the bound the buffers hold at most some 35 MB (a stored state
-/// is about 3.5 KB, most of it the 20×20 covariance). Where it binds, a late measurement reaches back less far than
-/// `engine.imu_buffer_s` (rejected as too old, counted).
+/// is about 3.5 KB, most of it the 20×20 covariance). Where it binds, a late measurement
+/// reaches back less far than `engine.imu_buffer_s` (rejected as too old, counted).
 pub const MAX_BUFFERED_IMU_SAMPLES: usize = 10_000;
 
 /// Most measurements waiting for the IMU to pass their time.

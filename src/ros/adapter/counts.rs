@@ -106,8 +106,9 @@ impl InputCounts {
     }
 
     /// The messages dropped before the engine that decoded: (name, count) of the IMU
-    /// stamp outliers, the ones that did not convert and the ones from a foreign frame (a velocity in a foreign frame
-    /// drops no message: its fix goes on alone), named as on /diagnostics.
+    /// stamp outliers, the ones that did not convert and the ones from a foreign frame (a
+    /// velocity in a foreign frame drops no message: its fix goes on alone), named as on
+    /// /diagnostics.
     pub fn dropped(&self) -> [(&'static str, u64); 8] {
         [
             ("imu_stamp_outliers", self.imu_stamp_outliers),

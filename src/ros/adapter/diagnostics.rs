@@ -69,9 +69,7 @@ impl RosAdapter {
             }],
         }
     }
-}
 
-impl RosAdapter {
     /// The message telling that another frame sent on `imu` lately, if one did.
     fn imu_frame_conflict(&self) -> Option<String> {
         self.imu_frame.conflict().map(|other| {

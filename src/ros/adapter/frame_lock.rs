@@ -7,7 +7,9 @@
 /// at most a window of the real stream, and a foreign publisher takes over a live stream
 /// only by sending more than 500 messages between two of its messages (50 kHz against a
 /// 100 Hz IMU). Without a clock nothing tells a flood from a fast sensor: a node that
-/// must resist one is given its frame (`imu_frame`).
+/// must resist one is given its frame (`imu_frame`). The GNSS and fix streams (1–10 Hz)
+/// follow the same rule, so there the window is 50 to 500 s, and no parameter fixes their
+/// frame yet.
 pub(super) const SWITCH_WINDOW_MESSAGES: u32 = 500;
 /// Other frames a window tells apart (more are counted in the window's total only).
 const TRACKED_FRAMES: usize = 4;
