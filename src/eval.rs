@@ -151,6 +151,10 @@ pub struct ErrorSummary {
     pub pos_rmse_n_m: f64,
     pub pos_rmse_u_m: f64,
     pub pos_rmse_horizontal_m: f64,
+    /// Horizontal RMSE after removing the mean east and north error of these epochs (m):
+    /// what a filter can change when the reference carries a common offset (a datum
+    /// offset of an RTK base, see docs/walk_0827.md).
+    pub pos_rmse_horizontal_offset_removed_m: f64,
     pub pos_rmse_3d_m: f64,
     pub vel_rmse_3d_mps: f64,
     pub att_rmse_roll_deg: f64,
@@ -186,12 +190,18 @@ pub fn summarize(errors: &[SolutionError]) -> ErrorSummary {
         .filter(|v| v.is_finite())
         .collect();
     let (e, n, u) = (pos(0), pos(1), pos(2));
+    // The RMS about the mean is the population standard deviation of each axis.
+    let spread = |i: usize| {
+        let mean = errors.iter().map(|e| e.position_enu_m[i]).sum::<f64>() / errors.len() as f64;
+        rms(errors.iter().map(|e| e.position_enu_m[i] - mean))
+    };
     ErrorSummary {
         epochs: errors.len(),
         pos_rmse_e_m: e,
         pos_rmse_n_m: n,
         pos_rmse_u_m: u,
         pos_rmse_horizontal_m: e.hypot(n),
+        pos_rmse_horizontal_offset_removed_m: spread(0).hypot(spread(1)),
         pos_rmse_3d_m: (e * e + n * n + u * u).sqrt(),
         vel_rmse_3d_mps: vel,
         att_rmse_roll_deg: att(0),
@@ -256,6 +266,8 @@ mod tests {
         assert!((s.pos_rmse_e_m - 3.0).abs() < 1e-12);
         assert!((s.pos_rmse_n_m - 8f64.sqrt()).abs() < 1e-12);
         assert!((s.pos_rmse_3d_m - 17f64.sqrt()).abs() < 1e-12);
+        // Means (0, 2): deviations (±3, ∓2).
+        assert!((s.pos_rmse_horizontal_offset_removed_m - 13f64.sqrt()).abs() < 1e-12);
         assert!((s.vel_rmse_3d_mps - 2.0).abs() < 1e-12);
         assert!((s.att_rmse_yaw_deg - 1.0).abs() < 1e-12);
         assert!((s.nees_mean - 3.0).abs() < 1e-12);

@@ -16,7 +16,7 @@ use std::path::Path;
 use std::process::Command;
 
 use adaptive_gnss_ins::ros::bag::{
-    BagWriteOptions, ChunkCompression, Durability, OfferedQos, Reliability,
+    BagError, BagReader, BagWriteOptions, ChunkCompression, Durability, OfferedQos, Reliability,
 };
 use adaptive_gnss_ins::ros::msg::{
     Clock, DiagnosticArray, DiagnosticStatus, GnssMeasurements, Imu, KeyValue, NavSatFix,
@@ -281,5 +281,38 @@ fn check_summary(summary: &Value, expected: &BTreeMap<String, ExpectedTopic>) {
             definitions.contains_key(type_name),
             "{type_name} not checked"
         );
+    }
+}
+
+/// A rosbag2 sqlite3 bag, as `ros2 bag record` wrote by default before Iron, written by
+/// rosbags: refused as a bag directory and as a `.db3` file, with how to convert it.
+#[test]
+fn a_sqlite3_bag_is_refused_with_how_to_convert_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let bag_dir = dir.path().join("old_bag");
+    let script = "import sys\n\
+        from rosbags.rosbag2 import Writer, StoragePlugin\n\
+        from rosbags.typesys import Stores, get_typestore\n\
+        store = get_typestore(Stores.ROS2_JAZZY)\n\
+        Clock = store.types['rosgraph_msgs/msg/Clock']\n\
+        Time = store.types['builtin_interfaces/msg/Time']\n\
+        with Writer(sys.argv[1], version=9, storage_plugin=StoragePlugin.SQLITE3) as w:\n\
+        \x20   c = w.add_connection('/clock', Clock.__msgtype__, typestore=store)\n\
+        \x20   w.write(c, 1, store.serialize_cdr(Clock(clock=Time(sec=0, nanosec=1)), Clock.__msgtype__))\n";
+    let status = Command::new(venv_support::python())
+        .args(["-c", script])
+        .arg(&bag_dir)
+        .status()
+        .unwrap();
+    assert!(status.success(), "rosbags could not write the sqlite3 bag");
+    let db3 = std::fs::read_dir(&bag_dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|e| e == "db3"))
+        .expect("rosbags wrote a .db3 file");
+    for path in [&bag_dir, &db3] {
+        let error = BagReader::open(path).err().expect("a .db3 bag is refused");
+        assert!(matches!(error, BagError::Sqlite3 { .. }), "{error}");
+        assert!(error.to_string().contains("ros2 bag convert"), "{error}");
     }
 }

@@ -96,6 +96,8 @@ const EVERY_KEY_CHANGED: &str = "
       ar_max_order: 3
       ar_order_criterion: bic
       ar_denominator_floor: 0.2
+      correlation_aware: true
+      variogram_max_lag: 12
       innovation_window: 40
       innovation_significance: 0.01
       pseudorange_sigma_min_m: 0.5

@@ -77,3 +77,56 @@ fn modes_rinex_cannot_serve_are_refused() {
     let nav_pvt = convert(&options(IonosphereMode::None, TruthInput::UbxNavPvt), &bag);
     assert!(matches!(nav_pvt, Err(ConvertError::TruthNeedsUbx)));
 }
+
+/// The carrier phases `convert` takes from RINEX (`L1C` and its LLI) are the receiver's:
+/// convbin wrote walk_1730.obs from the same log, and the RINEX-built epochs carry the
+/// RAWX-built epochs' phases to the file's three decimals, with the same wavelength.
+#[test]
+fn rinex_carrier_phases_are_the_receivers() {
+    use adaptive_gnss_ins::gnss::rinex_obs::build_rinex_epoch;
+    use adaptive_gnss_ins::gnss::ubx::{build_epoch, read_ubx_log};
+
+    let log = read_ubx_log(&walk_0827_support::read("gnss_1730.ubx"));
+    let text = std::fs::read_to_string(walk_0827_support::path("walk_1730.obs")).unwrap();
+    let obs = parse_rinex_obs(&text).unwrap();
+    let (mut compared, mut lock_lost, mut half_cycle) = (0, 0, 0);
+    for raw in &log.rawx {
+        let ubx = build_epoch(raw, &log.store, None);
+        let tow_s = ubx.receive_time.tow_s;
+        let Some(rinex) = obs
+            .epochs
+            .iter()
+            .find(|e| (e.time.tow_s - tow_s).abs() < 1e-3)
+        else {
+            continue;
+        };
+        let rinex = build_rinex_epoch(rinex, &log.store, None);
+        for sat in &rinex.epoch.satellites {
+            let Some(phase) = sat.carrier_phase else {
+                continue;
+            };
+            lock_lost += usize::from(phase.loss_of_lock);
+            half_cycle += usize::from(phase.half_cycle_unresolved);
+            assert_eq!((phase.sigma_cycles, phase.lock_time_s), (None, None));
+            let theirs = ubx
+                .epoch
+                .satellites
+                .iter()
+                .find(|s| s.sat == sat.sat)
+                .and_then(|s| s.carrier_phase)
+                .unwrap_or_else(|| panic!("{} at {tow_s}: no RAWX phase", sat.sat));
+            assert!(
+                (phase.cycles - theirs.cycles).abs() <= 5e-4 + 1e-9,
+                "{} at {tow_s}: {} against {}",
+                sat.sat,
+                phase.cycles,
+                theirs.cycles
+            );
+            assert_eq!(phase.wavelength_m, theirs.wavelength_m);
+            assert!(theirs.lock_time_s.is_some() && theirs.sigma_cycles.is_some());
+            compared += 1;
+        }
+    }
+    println!("{compared} phases compared; LLI loss of lock {lock_lost}, half cycle {half_cycle}");
+    assert!(compared > 2500, "{compared}");
+}

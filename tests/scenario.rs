@@ -822,3 +822,49 @@ fn builtins_load_and_bad_specs_are_typed_errors() {
         ScenarioError::ImuErrors(_)
     ));
 }
+
+/// The carrier phase: between consecutive epochs of a satellite, λΔφ is the change of the
+/// noise-free pseudo-range (the observation less the code error added) up to the phase
+/// error added and twice the ionosphere's change (millimetres in a second); every track
+/// starts with a loss of lock and a lock time of 0, then counts the time.
+#[test]
+fn carrier_phases_follow_the_range_with_their_own_noise() {
+    let scenario = Scenario::builtin("open_sky", 3).unwrap();
+    let mut previous: BTreeMap<SatId, (f64, f64, f64, f64)> = BTreeMap::new();
+    let (mut pairs, mut starts, mut worst_m) = (0, 0, 0.0f64);
+    for event in scenario.events().take_while(|e| {
+        e.as_ref()
+            .map_or(true, |e| !matches!(e, SimEvent::Imu(s) if s.t_s > 120.0))
+    }) {
+        let SimEvent::Gnss { epoch, truth, .. } = event.unwrap() else {
+            continue;
+        };
+        for (obs, err) in epoch.satellites.iter().zip(&truth.satellites) {
+            let phase = obs.carrier_phase.unwrap();
+            let lambda_m = phase.wavelength_m.unwrap();
+            let code_m = obs.pseudorange_m - err.pseudorange_error_m;
+            let now = (
+                epoch.t_s,
+                phase.cycles * lambda_m,
+                code_m,
+                err.carrier_phase_error_m,
+            );
+            match previous.insert(obs.sat, now) {
+                Some(before) if !phase.loss_of_lock => {
+                    let d = (now.1 - before.1) - (now.2 - before.2) - (now.3 - before.3);
+                    worst_m = worst_m.max(d.abs());
+                    assert!(phase.lock_time_s.unwrap() >= epoch.t_s - before.0 - 1e-9);
+                    pairs += 1;
+                }
+                _ => {
+                    assert!(phase.loss_of_lock, "{} at {}", obs.sat, epoch.t_s);
+                    assert_eq!(phase.lock_time_s, Some(0.0));
+                    starts += 1;
+                }
+            }
+        }
+    }
+    println!("{pairs} epoch pairs, {starts} track starts, worst |λΔφ − Δρ − Δε| {worst_m} m");
+    assert!(pairs > 800 && starts >= 8, "{pairs} pairs, {starts} starts");
+    assert!(worst_m < 0.01, "{worst_m} m");
+}

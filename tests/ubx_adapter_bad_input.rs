@@ -446,3 +446,48 @@ fn an_ephemeris_serves_across_the_end_of_the_gps_week() {
     // GPS seconds of ~1.4e9 s resolve 0.24 µs.
     assert!((after.epoch.t_s - before.epoch.t_s - 0.2).abs() < 1e-6);
 }
+
+/// The live path fills the carrier fields through the same code as `convert`: the first
+/// signal's phase (GPS L1 C/A, Galileo E1 in the default ionosphere-free mode) in cycles
+/// of its wavelength, with the receiver's σ and lock time, as the RAWX block says.
+#[test]
+fn published_epochs_carry_the_receivers_carrier_phase() {
+    let (bytes, _) = walk_log();
+    let log = read_ubx_log(&bytes);
+    let (_, out) = clean();
+    let l1_m = 299_792_458.0 / 1_575.42e6;
+    let (mut with_phase, mut satellites) = (0, 0);
+    for m in &out {
+        let raw = log
+            .rawx
+            .iter()
+            .find(|r| (r.rcv_tow_s - m.gps_time_of_week_s).abs() < 1e-6)
+            .expect("the RAWX of a published epoch");
+        for s in &m.satellites {
+            satellites += 1;
+            if s.carrier_phase_cycles.is_nan() {
+                continue;
+            }
+            with_phase += 1;
+            assert!((s.carrier_wavelength_m - l1_m).abs() < 1e-12, "{s:?}");
+            assert!((0.0..=64.5).contains(&s.carrier_lock_time_s), "{s:?}");
+            assert!(s.carrier_phase_sigma_cycles > 0.0, "{s:?}");
+            let block = raw
+                .measurements
+                .iter()
+                .find(|b| {
+                    sat_id(b.gnss_id, b.sv_id).is_some_and(|id| {
+                        (id.constellation.code(), id.prn) == (s.constellation, s.prn)
+                    }) && b.carrier_phase_cycles == s.carrier_phase_cycles
+                })
+                .unwrap_or_else(|| panic!("no RAWX block with the phase of {s:?}"));
+            assert!(block.tracking.cp_valid);
+            assert_eq!(block.lock_time_s, s.carrier_lock_time_s);
+        }
+    }
+    println!("{with_phase} of {satellites} satellite epochs with a carrier phase");
+    assert!(
+        with_phase * 10 > satellites * 9,
+        "{with_phase} of {satellites}"
+    );
+}

@@ -193,6 +193,11 @@ class SatelliteMeasurement(IdlStruct,
     satellite_clock_drift_s_s: float64 = 0.0
     ionosphere_delay_m: float64 = 0.0
     troposphere_delay_m: float64 = 0.0
+    carrier_phase_cycles: float64 = 0.0
+    carrier_wavelength_m: float64 = 0.0
+    carrier_phase_sigma_cycles: float64 = 0.0
+    carrier_lock_time_s: float64 = 0.0
+    carrier_phase_flags: uint8 = 0
 
 
 @dataclass

@@ -12,6 +12,7 @@
 pub mod adaptive_factor;
 pub mod ar_variance;
 pub mod burg;
+pub mod common_mode;
 pub mod equivalent_covariance;
 mod error;
 pub mod innovation;
@@ -23,5 +24,6 @@ pub mod q_scaling;
 pub mod random_weighting;
 pub mod redundant;
 pub mod residual_r;
+pub mod variogram;
 
 pub use error::AdaptiveError;

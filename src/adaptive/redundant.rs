@@ -19,6 +19,11 @@
 //!
 //! The caller must remove the receiver clock change from ∇Z first (see DESIGN.md,
 //! "Pitfalls"): it is common to all satellites and is not noise.
+//!
+//! Beyond the paper, an option ([`RedundantNoiseOptions::correlation_aware`]): the window's
+//! differences over several lags identify the variance and the correlation of the error
+//! together ([`super::variogram`]), and R̂ is the whole variance, slow part included, in
+//! both regimes (the KDE verdict is still given). Off, the estimator is the paper's.
 
 use std::collections::VecDeque;
 
@@ -27,6 +32,7 @@ use super::burg::{select_order, OrderCriterion};
 use super::error::{check_finite, AdaptiveError};
 use super::kde::{credibility_presorted, Credibility};
 use super::random_weighting::DirichletWeights;
+use super::variogram::fit_variogram;
 
 /// Options of one [`RedundantNoiseEstimator`]; all counts are in epochs (samples).
 #[derive(Debug, Clone, PartialEq)]
@@ -60,6 +66,13 @@ pub struct RedundantNoiseOptions {
     /// (the enhanced filter). Off, the estimator is the simple RMAE of eqs. (17)–(18) or
     /// (19) (the paper's SRMAKF). Default true.
     pub detect_non_gaussian: bool,
+    /// Estimate R as the sill of the white + AR(1) variogram fitted to the window's
+    /// differences over lags 1 … `variogram_max_lag` ([`super::variogram`]) instead of the
+    /// paper's methods. Default false.
+    pub correlation_aware: bool,
+    /// Longest lag of the variogram (epochs), at least 1; a third of the window at most is
+    /// used. Default 20.
+    pub variogram_max_lag: usize,
 }
 
 impl Default for RedundantNoiseOptions {
@@ -75,6 +88,8 @@ impl Default for RedundantNoiseOptions {
             ar_denominator_floor: 0.1,
             seed: 0,
             detect_non_gaussian: true,
+            correlation_aware: false,
+            variogram_max_lag: 20,
         }
     }
 }
@@ -105,6 +120,9 @@ impl RedundantNoiseOptions {
         }
         if self.kde_consecutive_epochs == 0 {
             return invalid("kde_consecutive_epochs", 0, "must be at least 1");
+        }
+        if self.variogram_max_lag == 0 {
+            return invalid("variogram_max_lag", 0, "must be at least 1");
         }
         if !(self.kde_threshold > 0.0 && self.kde_threshold.is_finite()) {
             return Err(AdaptiveError::InvalidParameter {
@@ -152,6 +170,13 @@ pub enum VarianceMethod {
     /// Non-Gaussian regime, but no AR model could be fitted because a lower order predicts
     /// the window exactly (zero prediction error, e.g. a frozen measurement): plain RMAE.
     RmaeFallback,
+    /// The sill of the white + AR(1) variogram (the correlation-aware option).
+    Variogram {
+        /// ρ₁ of the fitted error model.
+        lag1_correlation: f64,
+        /// Longest lag fitted (epochs).
+        lags: usize,
+    },
 }
 
 /// The estimate after one sample, once the window holds enough data.
@@ -334,6 +359,16 @@ impl RedundantNoiseEstimator {
     /// R̂ on the current window with the current regime's method.
     fn estimate_variance(&mut self) -> Result<(f64, VarianceMethod), AdaptiveError> {
         let window = self.window.make_contiguous();
+        if self.options.correlation_aware {
+            let fit = fit_variogram(window, self.options.variogram_max_lag)?;
+            return Ok((
+                fit.variance(),
+                VarianceMethod::Variogram {
+                    lag1_correlation: fit.lag1_correlation(),
+                    lags: fit.lags,
+                },
+            ));
+        }
         match self.regime {
             NoiseRegime::Gaussian if self.options.random_weighting => {
                 let moment = self.weights.second_moment(window)?;
@@ -466,6 +501,63 @@ mod tests {
         let mut o = small_options();
         o.kde_consecutive_epochs = 0;
         assert!(RedundantNoiseEstimator::new(o).is_err());
+        let mut o = small_options();
+        o.variogram_max_lag = 0;
+        assert!(RedundantNoiseEstimator::new(o).is_err());
+    }
+
+    #[test]
+    fn correlation_aware_option_sees_the_slow_part_the_papers_estimate_misses() {
+        use rand::SeedableRng;
+        use rand_distr::{Distribution, StandardNormal};
+        // Differences of an AR(1) error with σ = 2 and ρ₁ = 0.9 (variance 4). A window of
+        // 100 epochs of an error correlated over ten holds few independent samples, so
+        // single estimates scatter: the median over 20 000 epochs (200 windows) is compared.
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let mut normal = || -> f64 { StandardNormal.sample(&mut rng) };
+        let (phi, sigma) = (0.9, 2.0);
+        let mut v = sigma * normal();
+        let differences: Vec<f64> = (0..20_000)
+            .map(|_| {
+                let next = phi * v + sigma * (1.0f64 - phi * phi).sqrt() * normal();
+                let d = next - v;
+                v = next;
+                d
+            })
+            .collect();
+        let run = |options: RedundantNoiseOptions| {
+            let mut est = RedundantNoiseEstimator::new(options).unwrap();
+            let mut estimates = Vec::new();
+            for &d in &differences {
+                if let RedundantEstimate::Ready(e) = est.push(d).unwrap() {
+                    estimates.push(e);
+                }
+            }
+            let last = estimates[estimates.len() - 1];
+            let mut r: Vec<f64> = estimates.into_iter().map(|e| e.r_variance).collect();
+            r.sort_by(f64::total_cmp);
+            (r[r.len() / 2], last)
+        };
+        let (paper, _) = run(RedundantNoiseOptions {
+            detect_non_gaussian: false,
+            ..RedundantNoiseOptions::default()
+        });
+        let (aware_median, aware) = run(RedundantNoiseOptions {
+            correlation_aware: true,
+            ..RedundantNoiseOptions::default()
+        });
+        assert!(paper < 0.25 * 4.0, "{paper}");
+        assert!((aware_median / 4.0 - 1.0).abs() < 0.2, "{aware_median}");
+        match aware.method {
+            VarianceMethod::Variogram {
+                lag1_correlation,
+                lags,
+            } => {
+                assert_eq!(lags, 20);
+                assert!(lag1_correlation > 0.7, "{lag1_correlation}");
+            }
+            other => panic!("{other:?}"),
+        }
     }
 
     #[test]

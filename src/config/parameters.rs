@@ -229,6 +229,17 @@ parameter_table! {
         /// the variance at 1/floor.
         ar_denominator_floor: f64 = 0.1,
             unit "", range Range::Within(Interval::closed(1e-3, 1.0)), at_start;
+        /// Correlation-aware redundant-measurement estimation (srmakf, ermakf; beyond the
+        /// paper): the window's differences over lags 1..variogram_max_lag give the
+        /// variance and the correlation of the error together (white + first-order
+        /// Gauss-Markov variogram), and R is the whole variance, slow part included.
+        /// false = the paper's estimators (one-lag differences keep only 1 - rho1 of a
+        /// correlated error's variance).
+        correlation_aware: bool = false, unit "", range ANY, at_start;
+        /// Longest lag of the correlation-aware variogram; at most a third of the window
+        /// is used. Correlation times beyond it are not identified.
+        variogram_max_lag: usize = 20,
+            unit "epochs", range Range::Count { min: 1, max: MAX_WINDOW_EPOCHS }, at_start;
         /// Innovation window of the eiakf (innovation-based) estimator.
         innovation_window: usize = 50,
             unit "epochs", range Range::Count { min: 10, max: MAX_WINDOW_EPOCHS }, at_start;

@@ -81,6 +81,7 @@ pub fn unfilled_observation(sat: SatId, pseudorange_m: f64) -> SatObservation {
         sat_clock_drift_s_s: 0.0,
         iono_delay_m: None,
         tropo_delay_m: None,
+        carrier_phase: None,
     }
 }
 

@@ -492,6 +492,7 @@ mod tests {
             sat_clock_drift_s_s: 1e-11,
             iono_delay_m: None,
             tropo_delay_m: None,
+            carrier_phase: None,
         }
     }
 

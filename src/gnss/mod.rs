@@ -14,4 +14,4 @@ pub mod spp;
 pub mod time_scale;
 pub mod ubx;
 
-pub use observation::{Constellation, GnssEpoch, Klobuchar, SatId, SatObservation};
+pub use observation::{CarrierPhase, Constellation, GnssEpoch, Klobuchar, SatId, SatObservation};

@@ -78,6 +78,27 @@ pub struct SatObservation {
     pub iono_delay_m: Option<f64>,
     /// Tropospheric delay on this pseudo-range (m), if the source provides it.
     pub tropo_delay_m: Option<f64>,
+    /// The carrier phase, when tracked.
+    pub carrier_phase: Option<CarrierPhase>,
+}
+
+/// A carrier-phase measurement: the phase counted in cycles of its carrier, with the sign
+/// of the pseudo-range (it grows with the range) and an unknown, arbitrary integer
+/// ambiguity that stays constant while the receiver keeps lock.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CarrierPhase {
+    /// The phase (cycles).
+    pub cycles: f64,
+    /// Wavelength of the carrier (m); None: unknown, and the phase cannot be used.
+    pub wavelength_m: Option<f64>,
+    /// Receiver-reported 1σ of the phase (cycles).
+    pub sigma_cycles: Option<f64>,
+    /// Time the receiver has kept lock on the carrier (s).
+    pub lock_time_s: Option<f64>,
+    /// Lock was lost since the previous epoch: a cycle slip is possible.
+    pub loss_of_lock: bool,
+    /// The half-cycle ambiguity is not resolved: the phase may still jump by half a cycle.
+    pub half_cycle_unresolved: bool,
 }
 
 /// Klobuchar broadcast ionosphere coefficients (α in s, s/sc, ...; β in s, s/sc, ...).

@@ -836,6 +836,7 @@ mod tests {
             sat_clock_drift_s_s: 0.0,
             iono_delay_m: None,
             tropo_delay_m: None,
+            carrier_phase: None,
         }
     }
 

@@ -11,7 +11,7 @@ use super::msg::{
 };
 use crate::earth::Llh;
 use crate::engine::GnssFix;
-use crate::gnss::{Constellation, GnssEpoch, Klobuchar, SatId, SatObservation};
+use crate::gnss::{CarrierPhase, Constellation, GnssEpoch, Klobuchar, SatId, SatObservation};
 use crate::ins::ImuSample;
 
 /// Nanoseconds in one second.
@@ -313,7 +313,38 @@ fn sat_observation(
             .required("satellite_clock_drift_s_s", m.satellite_clock_drift_s_s)?,
         iono_delay_m: check.optional("ionosphere_delay_m", m.ionosphere_delay_m)?,
         tropo_delay_m: check.optional("troposphere_delay_m", m.troposphere_delay_m)?,
+        carrier_phase: carrier_phase(&check, m)?,
     })
+}
+
+/// The carrier phase of a satellite: None when `carrier_phase_cycles` is NaN (the other
+/// carrier fields are then not read). A NaN wavelength, σ or lock time is unknown; an
+/// infinite phase, a wavelength or σ that is not positive, or a negative lock time is an
+/// error. Flag bits beyond the `CARRIER_*` constants are ignored.
+fn carrier_phase(
+    check: &FieldCheck,
+    m: &SatelliteMeasurement,
+) -> Result<Option<CarrierPhase>, ConvertError> {
+    let Some(cycles) = check.optional("carrier_phase_cycles", m.carrier_phase_cycles)? else {
+        return Ok(None);
+    };
+    let lock_time_s = check.optional("carrier_lock_time_s", m.carrier_lock_time_s)?;
+    if lock_time_s.is_some_and(|t| t < 0.0) {
+        return Err(check.error(
+            "carrier_lock_time_s",
+            m.carrier_lock_time_s,
+            "a non-negative finite time or NaN (unknown)",
+        ));
+    }
+    let flags = m.carrier_phase_flags;
+    Ok(Some(CarrierPhase {
+        cycles,
+        wavelength_m: check.sigma("carrier_wavelength_m", m.carrier_wavelength_m)?,
+        sigma_cycles: check.sigma("carrier_phase_sigma_cycles", m.carrier_phase_sigma_cycles)?,
+        lock_time_s,
+        loss_of_lock: flags & SatelliteMeasurement::CARRIER_LOSS_OF_LOCK != 0,
+        half_cycle_unresolved: flags & SatelliteMeasurement::CARRIER_HALF_CYCLE_UNRESOLVED != 0,
+    }))
 }
 
 /// Checks the fields of one satellite, naming it in the errors.
@@ -354,7 +385,8 @@ impl FieldCheck {
         }
     }
 
-    /// A 1σ that is NaN when unknown (-> `None`), positive and finite otherwise.
+    /// A 1σ (or another positive quantity such as a wavelength) that is NaN when unknown
+    /// (-> `None`), positive and finite otherwise.
     fn sigma(&self, field: &'static str, value: f64) -> Result<Option<f64>, ConvertError> {
         if value.is_nan() {
             Ok(None)
@@ -548,6 +580,11 @@ mod tests {
             satellite_clock_drift_s_s: -5.6e-12,
             ionosphere_delay_m: f64::NAN,
             troposphere_delay_m: f64::NAN,
+            carrier_phase_cycles: 112_755_213.375,
+            carrier_wavelength_m: 0.190_293_672_798,
+            carrier_phase_sigma_cycles: 0.012,
+            carrier_lock_time_s: 12.5,
+            carrier_phase_flags: SatelliteMeasurement::CARRIER_HALF_CYCLE_UNRESOLVED | 0x80,
         }
     }
 
@@ -651,6 +688,63 @@ mod tests {
         msg.satellites[0].cn0_dbhz = f32::NAN;
         let sat = &GnssEpoch::try_from(&msg).unwrap().satellites[0];
         assert_eq!((sat.pseudorange_rate_mps, sat.cn0_dbhz), (None, None));
+    }
+
+    #[test]
+    fn carrier_phase_converts_with_its_flags_and_unknowns() {
+        let sat = &GnssEpoch::try_from(&epoch_msg()).unwrap().satellites[0];
+        let phase = sat.carrier_phase.unwrap();
+        assert_eq!(phase.cycles, 112_755_213.375);
+        assert_eq!(phase.wavelength_m, Some(0.190_293_672_798));
+        assert_eq!(phase.sigma_cycles, Some(0.012));
+        assert_eq!(phase.lock_time_s, Some(12.5));
+        assert!(!phase.loss_of_lock && phase.half_cycle_unresolved);
+
+        let mut msg = epoch_msg();
+        let m = &mut msg.satellites[0];
+        m.carrier_wavelength_m = f64::NAN;
+        m.carrier_phase_sigma_cycles = f64::NAN;
+        m.carrier_lock_time_s = f64::NAN;
+        m.carrier_phase_flags = SatelliteMeasurement::CARRIER_LOSS_OF_LOCK;
+        let phase = GnssEpoch::try_from(&msg).unwrap().satellites[0]
+            .carrier_phase
+            .unwrap();
+        assert_eq!(
+            (phase.wavelength_m, phase.sigma_cycles, phase.lock_time_s),
+            (None, None, None)
+        );
+        assert!(phase.loss_of_lock && !phase.half_cycle_unresolved);
+
+        // No phase: the other carrier fields are not read.
+        let mut msg = epoch_msg();
+        msg.satellites[0].carrier_phase_cycles = f64::NAN;
+        msg.satellites[0].carrier_wavelength_m = -1.0;
+        assert_eq!(
+            GnssEpoch::try_from(&msg).unwrap().satellites[0].carrier_phase,
+            None
+        );
+    }
+
+    #[test]
+    fn malformed_carrier_fields_name_the_field() {
+        type Spoil = fn(&mut SatelliteMeasurement);
+        let cases: [(Spoil, &str); 4] = [
+            (
+                |m| m.carrier_phase_cycles = f64::INFINITY,
+                "carrier_phase_cycles",
+            ),
+            (|m| m.carrier_wavelength_m = 0.0, "carrier_wavelength_m"),
+            (
+                |m| m.carrier_phase_sigma_cycles = -0.01,
+                "carrier_phase_sigma_cycles",
+            ),
+            (|m| m.carrier_lock_time_s = -1.0, "carrier_lock_time_s"),
+        ];
+        for (spoil, field) in cases {
+            let mut msg = epoch_msg();
+            spoil(&mut msg.satellites[0]);
+            assert_eq!(field_error(&msg), ("G05".to_string(), field));
+        }
     }
 
     #[test]

@@ -240,11 +240,29 @@ pub fn gnss_measurements(
                 satellite_clock_drift_s_s: s.sat_clock_drift_s_s,
                 ionosphere_delay_m: s.iono_delay_m.unwrap_or(nan),
                 troposphere_delay_m: s.tropo_delay_m.unwrap_or(nan),
+                carrier_phase_cycles: s.carrier_phase.map_or(nan, |c| c.cycles),
+                carrier_wavelength_m: s.carrier_phase.and_then(|c| c.wavelength_m).unwrap_or(nan),
+                carrier_phase_sigma_cycles: s
+                    .carrier_phase
+                    .and_then(|c| c.sigma_cycles)
+                    .unwrap_or(nan),
+                carrier_lock_time_s: s.carrier_phase.and_then(|c| c.lock_time_s).unwrap_or(nan),
+                carrier_phase_flags: s.carrier_phase.map_or(0, carrier_phase_flags),
             })
             .collect(),
         klobuchar_alpha: epoch.klobuchar.map_or([nan; 4], |k| k.alpha),
         klobuchar_beta: epoch.klobuchar.map_or([nan; 4], |k| k.beta),
     }
+}
+
+/// The `CARRIER_*` bits of a carrier phase.
+fn carrier_phase_flags(c: crate::gnss::CarrierPhase) -> u8 {
+    let bit = |set: bool, value: u8| if set { value } else { 0 };
+    bit(c.loss_of_lock, SatelliteMeasurement::CARRIER_LOSS_OF_LOCK)
+        | bit(
+            c.half_cycle_unresolved,
+            SatelliteMeasurement::CARRIER_HALF_CYCLE_UNRESOLVED,
+        )
 }
 
 /// sensor_msgs/NavSatFix of a receiver fix (ENU covariance, known or the diagonal given).

@@ -91,9 +91,9 @@ pub enum PlayError {
     TypeName { topic: String, type_name: String },
     #[error("invalid topic name `{0}`")]
     TopicName(String),
-    #[error("--rate must be a positive number, got {0}")]
+    #[error("--rate must lie in [{MIN_RATE}, {MAX_RATE}], got {0}")]
     Rate(f64),
-    #[error("--clock-hz must be a positive number, got {0}")]
+    #[error("--clock-hz must lie in [{MIN_CLOCK_HZ}, {MAX_CLOCK_HZ}], got {0}")]
     ClockRate(f64),
     #[error("--wait-for {0}: the bag has no such topic")]
     UnknownWaitTopic(String),
@@ -138,6 +138,17 @@ fn message_type_name(type_name: &str) -> Option<MessageTypeName> {
         _ => None,
     }
 }
+
+/// Slowest and fastest speed factors. Choice: a thousandth of real time already turns a
+/// second of recording into a quarter of an hour, and a thousand times real time is
+/// beyond what DDS delivers for a 200 Hz IMU without loss; outside, the release times
+/// overflow a `Duration` (a rate of 1e-300) or collapse to zero.
+pub const MIN_RATE: f64 = 1e-3;
+pub const MAX_RATE: f64 = 1e3;
+/// Slowest and fastest `/clock` rates (Hz of bag time): 1e4 Hz is 0.1 ms of bag time per
+/// tick, finer than any consumer's timer; below 0.01 Hz the clock would barely move.
+pub const MIN_CLOCK_HZ: f64 = 1e-2;
+pub const MAX_CLOCK_HZ: f64 = 1e4;
 
 /// Wall-clock offset from the start of a pass at which a message recorded `since_start`
 /// after the bag's first message is released, at speed `rate`.
@@ -184,10 +195,10 @@ fn create_writer<M: Serialize>(
 /// Plays `bag` onto DDS; returns when the bag has played (never with `repeat`, unless
 /// the bag cannot be read).
 pub fn play(bag: &Path, options: &PlayOptions) -> Result<PlayReport, PlayError> {
-    if !(options.rate.is_finite() && options.rate > 0.0) {
+    if !(MIN_RATE..=MAX_RATE).contains(&options.rate) {
         return Err(PlayError::Rate(options.rate));
     }
-    if options.clock && !(options.clock_hz.is_finite() && options.clock_hz > 0.0) {
+    if options.clock && !(MIN_CLOCK_HZ..=MAX_CLOCK_HZ).contains(&options.clock_hz) {
         return Err(PlayError::ClockRate(options.clock_hz));
     }
     let reader = BagReader::open(bag)?;
@@ -395,6 +406,38 @@ mod tests {
         );
         assert!(message_type_name("sensor_msgs/Imu").is_none());
         assert!(message_type_name("a/srv/B").is_none());
+    }
+
+    #[test]
+    fn rates_outside_their_range_are_refused_before_the_bag_is_opened() {
+        let options = |rate: f64, clock_hz: f64| PlayOptions {
+            rate,
+            clock: true,
+            clock_hz,
+            repeat: false,
+            delay: Duration::ZERO,
+            wait_for_topics: Vec::new(),
+            domain_id: 0,
+        };
+        let missing = Path::new("/nonexistent/bag.mcap");
+        for rate in [1e-300, 0.0, -1.0, f64::NAN, f64::INFINITY, 1e300] {
+            let err = play(missing, &options(rate, 100.0)).unwrap_err();
+            assert!(matches!(err, PlayError::Rate(_)), "rate {rate}: {err}");
+        }
+        for clock_hz in [1e-300, 0.0, f64::NAN, 1e300] {
+            let err = play(missing, &options(1.0, clock_hz)).unwrap_err();
+            assert!(
+                matches!(err, PlayError::ClockRate(_)),
+                "clock {clock_hz}: {err}"
+            );
+        }
+        // At the limits the release offsets stay finite.
+        let hour = Duration::from_secs(3600);
+        assert_eq!(
+            release_offset(hour, MIN_RATE),
+            Duration::from_secs(3_600_000)
+        );
+        assert_eq!(release_offset(hour, MAX_RATE), Duration::from_millis(3600));
     }
 
     #[test]

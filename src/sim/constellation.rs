@@ -28,7 +28,7 @@ use crate::gnss::atmosphere::{klobuchar_delay_m, saastamoinen_delay_m};
 use crate::gnss::geometry::{
     elevation_azimuth, line_of_sight, rotate_about_earth_axis, GnssModelError,
 };
-use crate::gnss::{Constellation, GnssEpoch, Klobuchar, SatId, SatObservation};
+use crate::gnss::{CarrierPhase, Constellation, GnssEpoch, Klobuchar, SatId, SatObservation};
 
 /// Nominal GPS semi-major axis (m).
 pub const GPS_SEMI_MAJOR_AXIS_M: f64 = 26_559_700.0;
@@ -237,6 +237,9 @@ pub struct ObservationNoise {
     pub pseudorange_rate_mps: f64,
 }
 
+/// The simulated signal's carrier wavelength (GPS L1, m).
+pub const L1_WAVELENGTH_M: f64 = crate::earth::SPEED_OF_LIGHT_M_S / 1_575.42e6;
+
 /// Light-time solution: iterations and tolerance (s). Each iteration shrinks the error by
 /// about |v_sat| / c ≈ 10⁻⁵.
 const LIGHT_TIME_MAX_ITERATIONS: usize = 10;
@@ -364,7 +367,9 @@ impl GpsConstellation {
 
     /// Simulated observation of `sat` by a receiver in state `rx` at true GPS reception
     /// time `t_rx_s`:
-    ///   ρ_obs = ρ + b − c·δT_sat(t_tx) + I + T + noise,  ρ̇_obs = ρ̇ + ḃ − c·δṪ_sat + noise.
+    ///   ρ_obs = ρ + b − c·δT_sat(t_tx) + I + T + noise,  ρ̇_obs = ρ̇ + ḃ − c·δṪ_sat + noise,
+    ///   λφ = ρ + b − c·δT_sat(t_tx) − I + T (L1, no ambiguity and no noise: the scenario
+    ///   adds them, see [`crate::sim::carrier`]).
     /// The transmission time t_tx solves c (t_rx − t_tx) = |R3(ω_e (t_rx − t_tx)) r_s(t_tx)
     /// − r_rx| by iteration, evaluating the orbit at each trial t_tx; the observation
     /// carries the satellite state at t_tx in the ECEF frame of t_tx, as the message
@@ -504,6 +509,15 @@ impl GpsConstellation {
             sat_clock_drift_s_s: tx.clock_drift_s_s,
             iono_delay_m: atmosphere.report_delays.then_some(iono_m),
             tropo_delay_m: atmosphere.report_delays.then_some(tropo_m),
+            carrier_phase: Some(CarrierPhase {
+                cycles: (range_m + rx.clock_bias_m - c * tx.clock_bias_s - iono_m + tropo_m)
+                    / L1_WAVELENGTH_M,
+                wavelength_m: Some(L1_WAVELENGTH_M),
+                sigma_cycles: None,
+                lock_time_s: None,
+                loss_of_lock: false,
+                half_cycle_unresolved: false,
+            }),
         };
         Ok((obs, elevation_rad))
     }

@@ -5,6 +5,7 @@
 //! signal environments (foliage, urban canyon, outage) into one event stream. No I/O.
 
 pub mod ar_process;
+pub mod carrier;
 pub mod constellation;
 pub mod environment;
 pub mod imu_errors;

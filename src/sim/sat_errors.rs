@@ -9,7 +9,9 @@
 //! scenarios with the same seed and geometry carry the same thermal noise.
 //!
 //! Added errors per received satellite (see [`crate::sim::environment`]):
-//! pseudo-range: thermal + multipath + NLOS bias + outlier; rate: thermal + multipath.
+//! pseudo-range: thermal + multipath + NLOS bias + outlier; rate: thermal + multipath;
+//! carrier phase: thermal (the phase-lock loop's; multipath on the phase is millimetres
+//! and left out).
 
 use std::collections::BTreeMap;
 
@@ -40,6 +42,10 @@ pub enum StreamPurpose {
     Events = 6,
     /// A satellite's NLOS state in an urban-canyon segment.
     Nlos = 7,
+    /// A satellite's carrier-phase noise.
+    CarrierPhase = 8,
+    /// The integer ambiguity of a satellite's carrier-phase track.
+    CarrierAmbiguity = 9,
 }
 
 /// 32-bit words reserved per epoch (or segment) in a stream. Choice: 2²⁰ words; an epoch
@@ -78,6 +84,8 @@ pub struct SatErrorTruth {
     pub pseudorange_error_m: f64,
     /// Total error added to the pseudo-range rate (m/s).
     pub pseudorange_rate_error_mps: f64,
+    /// Error added to the carrier phase (m), besides its ambiguity.
+    pub carrier_phase_error_m: f64,
     /// Its multipath part on the pseudo-range (m).
     pub multipath_m: f64,
     /// Its multipath part on the rate (m/s).
@@ -227,6 +235,7 @@ impl SatErrorGenerator {
             cn0_dbhz,
             pseudorange_error_m: 0.0,
             pseudorange_rate_error_mps: 0.0,
+            carrier_phase_error_m: 0.0,
             multipath_m: 0.0,
             multipath_rate_mps: 0.0,
             nlos_bias_m: 0.0,
@@ -274,6 +283,15 @@ impl SatErrorGenerator {
             + truth.outlier_m;
         truth.pseudorange_rate_error_mps =
             white_scale * sigma_rate * xi_rate + truth.multipath_rate_mps;
+        let mut phase_rng = stream_rng(
+            self.seed,
+            StreamPurpose::CarrierPhase,
+            Some(ctx.sat),
+            ctx.epoch_index,
+        );
+        let xi_phase: f64 = StandardNormal.sample(&mut phase_rng);
+        truth.carrier_phase_error_m =
+            white_scale * self.thermal.carrier_phase_sigma_zenith_m * ratio * xi_phase;
         truth.pseudorange_sigma_m =
             (sigma_range * sigma_range * white_variance_factor + extra_range_variance).sqrt();
         truth.pseudorange_rate_sigma_mps =

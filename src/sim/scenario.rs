@@ -21,6 +21,7 @@ use crate::gnss::geometry::{elevation_azimuth, line_of_sight};
 use crate::gnss::spp::{solve_spp, SigmaModel, SppConfig, SppSolution};
 use crate::gnss::{GnssEpoch, SatId};
 use crate::ins::ImuSample;
+use crate::sim::carrier::CarrierTracks;
 use crate::sim::constellation::{
     AtmosphereTruth, GpsConstellation, ObservationNoise, ReceiverTruth,
 };
@@ -239,6 +240,7 @@ impl Scenario {
                 self.spec.gnss.thermal_noise.clone(),
                 self.foliage.clone(),
             ),
+            carrier: CarrierTracks::new(self.seed),
             imu: Stream::new(self.spec.imu.rate_hz, count(self.spec.imu.rate_hz)),
             truth: Stream::new(self.spec.truth_rate_hz, count(self.spec.truth_rate_hz)),
             gnss: Stream::new(self.spec.gnss.rate_hz, count(self.spec.gnss.rate_hz)),
@@ -260,7 +262,7 @@ impl Scenario {
         index: u64,
         t_s: f64,
         clock: ReceiverClockState,
-        sat_errors: &mut SatErrorGenerator,
+        (sat_errors, carrier): (&mut SatErrorGenerator, &mut CarrierTracks),
         out: &mut VecDeque<SimEvent>,
     ) -> Result<(), ScenarioError> {
         let (segment, environment) = self.environment_at(t_s);
@@ -330,6 +332,9 @@ impl Scenario {
                     .pseudorange_rate_mps
                     .map(|r| r + err.pseudorange_rate_error_mps);
                 obs.cn0_dbhz = Some(err.cn0_dbhz);
+                obs.carrier_phase = obs.carrier_phase.map(|phase| {
+                    carrier.receive(obs.sat, index, t_s, phase, err.carrier_phase_error_m)
+                });
                 satellites.push(obs);
                 sat_truths.push(err);
             }
@@ -417,6 +422,7 @@ pub struct ScenarioEvents<'a> {
     clock_rng: rand_chacha::ChaCha8Rng,
     clock_t_s: f64,
     sat_errors: SatErrorGenerator,
+    carrier: CarrierTracks,
     imu: Stream,
     truth: Stream,
     gnss: Stream,
@@ -448,7 +454,7 @@ impl ScenarioEvents<'_> {
                     index,
                     t_s,
                     self.clock.state(),
-                    &mut self.sat_errors,
+                    (&mut self.sat_errors, &mut self.carrier),
                     &mut self.pending,
                 )?;
             }

@@ -87,6 +87,9 @@ pub struct ThermalNoiseSpec {
     pub cn0_zenith_dbhz: f64,
     /// C/N0 at the horizon in open sky (dB-Hz), ≤ cn0_zenith.
     pub cn0_horizon_dbhz: f64,
+    /// Carrier-phase σ at the zenith in open sky (m), ≥ 0; it follows the C/N0 like the
+    /// code's (a phase-lock loop's jitter is also ∝ 1/√(C/N0)).
+    pub carrier_phase_sigma_zenith_m: f64,
 }
 
 impl Default for ThermalNoiseSpec {
@@ -94,13 +97,16 @@ impl Default for ThermalNoiseSpec {
     /// a narrow correlator is decimetres, plus residual unmodelled effects; a Doppler-
     /// derived rate a few cm/s (Groves, Principles of GNSS, Inertial and Multisensor
     /// Integrated Navigation, 2nd ed., ch. 9). C/N0 35–50 dB-Hz is a typical open-sky span
-    /// from horizon to zenith.
+    /// from horizon to zenith. The carrier phase 2 mm at the zenith: an L1 phase-lock
+    /// loop's thermal jitter is about a millimetre at 50 dB-Hz (ibid.), doubled for the
+    /// oscillator and residual multipath.
     fn default() -> Self {
         Self {
             pseudorange_sigma_zenith_m: 0.5,
             pseudorange_rate_sigma_zenith_mps: 0.05,
             cn0_zenith_dbhz: 50.0,
             cn0_horizon_dbhz: 35.0,
+            carrier_phase_sigma_zenith_m: 0.002,
         }
     }
 }
@@ -308,7 +314,8 @@ impl ScenarioSpec {
         let t = &g.thermal_noise;
         let non_negative = |x: f64| x.is_finite() && x >= 0.0;
         if !(non_negative(t.pseudorange_sigma_zenith_m)
-            && non_negative(t.pseudorange_rate_sigma_zenith_mps))
+            && non_negative(t.pseudorange_rate_sigma_zenith_mps)
+            && non_negative(t.carrier_phase_sigma_zenith_m))
         {
             return Err(invalid(
                 "gnss.thermal_noise",

@@ -31,8 +31,10 @@ pub enum Command {
         /// A built-in scenario name (default, open_sky, static) or a scenario YAML file.
         #[arg(long, default_value = "default")]
         scenario: String,
+        /// Seed of every random draw: the same seed gives the same bag.
         #[arg(long, default_value_t = 1)]
         seed: u64,
+        /// Output bag (.mcap).
         #[arg(long)]
         out: PathBuf,
         /// Also write the receiver's velocities on /gnss/velocity
@@ -42,6 +44,7 @@ pub enum Command {
     },
     /// Stream a bag through the engine; write the solution; score it against a reference.
     Replay {
+        /// Input bag: an .mcap file or a rosbag2 directory holding one.
         bag: PathBuf,
         /// Parameter file (ROS 2 params layout, as the node reads it); repeat it to load
         /// a preset over the manual, e.g. --params params/ekf.yaml --params
@@ -68,6 +71,7 @@ pub enum Command {
     },
     /// Run several filter variants over one bag and tabulate their errors.
     Compare {
+        /// Input bag: an .mcap file or a rosbag2 directory holding one.
         bag: PathBuf,
         /// Comma-separated variants (e.g. ekf,ermakf); all when absent.
         #[arg(long, value_delimiter = ',')]
@@ -85,6 +89,7 @@ pub enum Command {
         /// solution quality in a converted bag: rtk_fixed, rtk_float).
         #[arg(long)]
         by_environment: bool,
+        /// How the results are printed: an aligned table, JSON or CSV.
         #[arg(long, value_enum, default_value_t = Format::Table)]
         format: Format,
         /// Folder for PNG and SVG figures of the errors over time and of the estimated
@@ -100,6 +105,7 @@ pub enum Command {
     Spp(SppArgs),
     /// Simulate the default scenario into a temporary folder and compare every variant.
     Demo {
+        /// Seed of the simulated scenario.
         #[arg(long, default_value_t = 1)]
         seed: u64,
     },
@@ -375,8 +381,13 @@ fn load_scenario(name_or_file: &str, seed: u64) -> Result<Scenario, String> {
     let spec = if ScenarioSpec::builtin_names().contains(&name_or_file) {
         ScenarioSpec::builtin(name_or_file).map_err(|e| e.to_string())?
     } else {
-        let text = std::fs::read_to_string(name_or_file)
-            .map_err(|e| format!("scenario {name_or_file}: {e}"))?;
+        let text = std::fs::read_to_string(name_or_file).map_err(|e| {
+            format!(
+                "scenario {name_or_file}: neither a built-in scenario ({}) nor a readable \
+                 scenario YAML file: {e}",
+                ScenarioSpec::builtin_names().join(", ")
+            )
+        })?;
         ScenarioSpec::from_yaml(&text).map_err(|e| format!("{name_or_file}: {e}"))?
     };
     Scenario::new(spec, seed).map_err(|e| e.to_string())

@@ -10,14 +10,15 @@ use crate::ros::player::{self, PlayOptions};
 
 #[derive(Args)]
 pub struct PlayArgs {
+    /// The bag to play: an .mcap file or a rosbag2 directory holding one.
     bag: PathBuf,
-    /// Speed factor (2 plays twice as fast as recorded).
+    /// Speed factor (2 plays twice as fast as recorded), 0.001 to 1000.
     #[arg(long, default_value_t = 1.0)]
     rate: f64,
     /// Publish /clock (rosgraph_msgs/Clock) with the bag's time, for use_sim_time.
     #[arg(long)]
     clock: bool,
-    /// Rate of /clock in bag time (Hz).
+    /// Rate of /clock in bag time (Hz), 0.01 to 10000.
     #[arg(long, default_value_t = 40.0)]
     clock_hz: f64,
     /// Play again from the start when the bag ends, until stopped.

@@ -207,8 +207,10 @@ pub struct ConvertArgs {
     /// stamped with --imu-tag; gpst_s: GPST seconds since 1970), '-' to ignore a column.
     #[arg(long, default_value = "ax,ay,az,gx,gy,gz,tick_ms")]
     pub imu_columns: String,
+    /// Unit of the accelerometer columns.
     #[arg(long, value_enum, default_value_t = AccelUnitArg::G)]
     pub imu_accel_unit: AccelUnitArg,
+    /// Unit of the gyro columns.
     #[arg(long, value_enum, default_value_t = GyroUnitArg::DegPerS)]
     pub imu_gyro_unit: GyroUnitArg,
     /// Rotation taking IMU-axis vectors into the FLU body frame: roll,pitch,yaw in degrees,
@@ -225,8 +227,10 @@ pub struct ConvertArgs {
     pub robot_bag: RobotBagArgs,
     #[command(flatten)]
     pub reference: ReferenceArgs,
+    /// Which ephemerides each epoch may use.
     #[arg(long, value_enum, default_value_t = EphemerisArg::WholeLog)]
     pub ephemeris: EphemerisArg,
+    /// The pseudo-ranges to form.
     #[arg(long, value_enum, default_value_t = IonosphereArg::IonoFree)]
     pub ionosphere: IonosphereArg,
     /// Output bag.
@@ -237,6 +241,7 @@ pub struct ConvertArgs {
 impl ConvertArgs {
     /// The conversion these arguments ask for.
     pub fn options(&self) -> Result<ConvertOptions, String> {
+        self.check_numbers()?;
         let imu = match &self.imu_csv {
             None => None,
             Some(csv) => {
@@ -304,6 +309,39 @@ impl ConvertArgs {
             },
             ionosphere: self.ionosphere.mode(),
         })
+    }
+}
+
+impl ConvertArgs {
+    /// Every numeric argument within its range (NaN never is).
+    ///
+    /// Choice of ranges: mounting angles within ±360°; geoid separations within ±120 m
+    /// (the EGM2008 undulation spans −107…+86 m); GPS − UTC a whole number of seconds in
+    /// 0..=100 (18 since 2017); a receiver-to-host latency up to 10 s.
+    fn check_numbers(&self) -> Result<(), String> {
+        for angle in &self.imu_to_flu_rpy_deg {
+            within("imu-to-flu-rpy-deg", *angle, -360.0, 360.0)?;
+        }
+        let r = &self.reference;
+        within("geoid-separation-m", r.geoid_separation_m, -120.0, 120.0)?;
+        within("leap-seconds", r.leap_seconds, 0.0, 100.0)?;
+        if r.leap_seconds.fract() != 0.0 {
+            return Err(format!(
+                "--leap-seconds must be a whole number, got {}",
+                r.leap_seconds
+            ));
+        }
+        within("host-latency-s", self.robot_bag.host_latency_s, 0.0, 10.0)?;
+        Ok(())
+    }
+}
+
+/// An error naming argument `--name` unless `value` lies in [lo, hi].
+fn within(name: &str, value: f64, lo: f64, hi: f64) -> Result<(), String> {
+    if (lo..=hi).contains(&value) {
+        Ok(())
+    } else {
+        Err(format!("--{name} must lie in [{lo}, {hi}], got {value}"))
     }
 }
 
@@ -466,13 +504,18 @@ pub fn spp(args: SppArgs) -> Result<(), String> {
         println!("  inter-system bias of {c:?} against the first clock: {bias_m:.3} m mean over {n} epochs");
     }
     println!(
-        "{:<14} {:>7} {:>8} {:>8} {:>8}",
-        "reference", "epochs", "horiz_m", "vert_m", "pos3d_m"
+        "{:<14} {:>7} {:>8} {:>12} {:>8} {:>8}",
+        "reference", "epochs", "horiz_m", "horiz_demean", "vert_m", "pos3d_m"
     );
     for (label, s) in report.summary_by_label() {
         println!(
-            "{:<14} {:>7} {:>8.3} {:>8.3} {:>8.3}",
-            label, s.epochs, s.pos_rmse_horizontal_m, s.pos_rmse_u_m, s.pos_rmse_3d_m
+            "{:<14} {:>7} {:>8.3} {:>12.3} {:>8.3} {:>8.3}",
+            label,
+            s.epochs,
+            s.pos_rmse_horizontal_m,
+            s.pos_rmse_horizontal_offset_removed_m,
+            s.pos_rmse_u_m,
+            s.pos_rmse_3d_m
         );
     }
     Ok(())
@@ -510,4 +553,42 @@ pub fn spp_rinex(args: SppRinexArgs) -> Result<(), String> {
         s.skipped_records
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::Parser;
+
+    use super::ConvertArgs;
+
+    #[derive(Parser)]
+    struct Convert {
+        #[command(flatten)]
+        args: ConvertArgs,
+    }
+
+    fn options_of(extra: &[&str]) -> Result<(), String> {
+        let mut argv = vec!["convert", "--ubx", "log.ubx", "--out", "out.mcap"];
+        argv.extend_from_slice(extra);
+        let parsed = Convert::try_parse_from(argv).map_err(|e| e.to_string())?;
+        parsed.args.options().map(|_| ())
+    }
+
+    #[test]
+    fn numeric_arguments_out_of_range_are_refused() {
+        assert_eq!(options_of(&[]), Ok(()));
+        assert_eq!(options_of(&["--imu-to-flu-rpy-deg", "180,-90,45"]), Ok(()));
+        for bad in [
+            ["--imu-to-flu-rpy-deg", "nan,0,0"],
+            ["--imu-to-flu-rpy-deg", "0,1e300,0"],
+            ["--geoid-separation-m", "nan"],
+            ["--geoid-separation-m", "-1e9"],
+            ["--leap-seconds", "inf"],
+            ["--leap-seconds", "18.5"],
+            ["--host-latency-s", "11"],
+        ] {
+            let err = options_of(&bad).expect_err(&bad.join(" "));
+            assert!(err.contains(bad[0]), "{}: {err}", bad.join(" "));
+        }
+    }
 }

@@ -292,6 +292,8 @@ pub struct EnvironmentRow {
     pub environment: String,
     pub epochs: usize,
     pub pos_rmse_horizontal_m: f64,
+    /// Horizontal RMSE after removing the mean offset over the environment's epochs.
+    pub pos_rmse_horizontal_offset_removed_m: f64,
     pub pos_rmse_u_m: f64,
     pub pos_rmse_3d_m: f64,
     pub vel_rmse_3d_mps: f64,
@@ -310,6 +312,7 @@ impl EnvironmentRow {
                 environment: environment.clone(),
                 epochs: s.epochs,
                 pos_rmse_horizontal_m: s.pos_rmse_horizontal_m,
+                pos_rmse_horizontal_offset_removed_m: s.pos_rmse_horizontal_offset_removed_m,
                 pos_rmse_u_m: s.pos_rmse_u_m,
                 pos_rmse_3d_m: s.pos_rmse_3d_m,
                 vel_rmse_3d_mps: s.vel_rmse_3d_mps,
@@ -321,16 +324,24 @@ impl EnvironmentRow {
 /// The comparison by environment as an aligned text table.
 pub fn format_environment_table(rows: &[EnvironmentRow]) -> String {
     let mut out = format!(
-        "{:<14} {:<14} {:>7} {:>8} {:>8} {:>8} {:>9}\n",
-        "filter", "environment", "epochs", "horiz_m", "vert_m", "pos3d_m", "vel_mps"
+        "{:<14} {:<14} {:>7} {:>8} {:>12} {:>8} {:>8} {:>9}\n",
+        "filter",
+        "environment",
+        "epochs",
+        "horiz_m",
+        "horiz_demean",
+        "vert_m",
+        "pos3d_m",
+        "vel_mps"
     );
     for r in rows {
         out.push_str(&format!(
-            "{:<14} {:<14} {:>7} {:>8.3} {:>8.3} {:>8.3} {:>9.4}\n",
+            "{:<14} {:<14} {:>7} {:>8.3} {:>12.3} {:>8.3} {:>8.3} {:>9.4}\n",
             r.filter,
             r.environment,
             r.epochs,
             r.pos_rmse_horizontal_m,
+            r.pos_rmse_horizontal_offset_removed_m,
             r.pos_rmse_u_m,
             r.pos_rmse_3d_m,
             r.vel_rmse_3d_mps

@@ -92,6 +92,11 @@ pub fn gnss(k: u64, t_ns: u64) -> GnssMeasurements {
             satellite_clock_drift_s_s: 1e-12,
             ionosphere_delay_m: 2.5,
             troposphere_delay_m: 2.3,
+            carrier_phase_cycles: 1.1e8 + 5250.0 * k as f64,
+            carrier_wavelength_m: 0.190_293_672_798,
+            carrier_phase_sigma_cycles: 0.008,
+            carrier_lock_time_s: k as f64,
+            carrier_phase_flags: 0,
         })
         .collect();
     GnssMeasurements {

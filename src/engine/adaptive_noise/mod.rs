@@ -13,6 +13,7 @@ use std::collections::HashMap;
 use nalgebra::{DMatrix, DVector};
 
 use crate::config::{Config, NoiseStrategy};
+use crate::filter::measurement_rows::Row;
 use crate::gnss::SatId;
 
 use super::output::MeasurementKind;
@@ -39,6 +40,9 @@ pub struct ScalarMeasurement {
     pub predicted: f64,
     /// h P⁻ hᵀ of its row.
     pub hph: f64,
+    /// Its row of H (the redundant strategy's correlation-aware option takes the
+    /// geometry of the error common to all satellites from it).
+    pub row: Row,
     /// The variance of the fixed σ model (gnss.*), used until an estimate is trusted.
     pub r_nominal: f64,
 }
@@ -106,14 +110,17 @@ impl NoiseModel {
         rows: &[ScalarMeasurement],
         learn: bool,
     ) -> Vec<NoiseVerdict> {
-        rows.iter()
-            .map(|row| match self {
-                Self::Fixed => NoiseVerdict::nominal(row.r_nominal),
-                Self::Innovation(m) => m.variance(t_s, row, learn),
-                Self::Redundant(m) => m.variance(t_s, row, learn),
-                Self::Residual(m) => m.variance(row),
-            })
-            .collect()
+        match self {
+            Self::Redundant(m) => m.variances(t_s, rows, learn),
+            _ => rows
+                .iter()
+                .map(|row| match self {
+                    Self::Innovation(m) => m.variance(t_s, row, learn),
+                    Self::Residual(m) => m.variance(row),
+                    Self::Fixed | Self::Redundant(_) => NoiseVerdict::nominal(row.r_nominal),
+                })
+                .collect(),
+        }
     }
 
     /// True when the strategy needs the predictions of the corrected state.

@@ -189,6 +189,7 @@ mod tests {
             measured: 10.0,
             predicted: 0.0,
             hph: 1.0,
+            row: crate::filter::measurement_rows::Row::zeros(),
             r_nominal: 9.0,
         };
         for k in 0..4 {

@@ -111,6 +111,7 @@ impl<M: MeasurementModel> Step<'_, M> {
                 measured: lin.measured[i],
                 predicted: lin.predicted[i],
                 hph: row_variance(&lin.rows[i], &state.p),
+                row: lin.rows[i],
                 r_nominal: c.r_nominal,
             })
             .collect();

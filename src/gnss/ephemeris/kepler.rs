@@ -214,7 +214,8 @@ impl KeplerianEphemeris {
     }
 
     /// Satellite position, velocity and clock at GPST `t` (the transmission time). None if
-    /// the ephemeris is not valid (see [`Self::is_valid`]) or `t` is not finite.
+    /// the ephemeris is not valid (see [`Self::is_valid`]), `t` is not finite, or the
+    /// result lies outside the bounds of any GNSS orbit and clock (corrupt elements).
     ///
     /// Math note (time of the ephemeris): t_k = t − toe uses GPST on both sides; for
     /// BeiDou and Galileo the reference times were converted to GPST, so t_k equals the
@@ -304,6 +305,13 @@ impl KeplerianEphemeris {
         let clock_bias_s =
             self.af0_s + self.af1_s_s * dtc + self.af2_s_s2 * dtc * dtc + relativistic_s;
         let clock_drift_s_s = self.af1_s_s + 2.0 * self.af2_s_s2 * dtc + relativistic_rate;
+        let plausible = (MIN_ORBIT_RADIUS_M..=MAX_ORBIT_RADIUS_M).contains(&pos_ecef_m.norm())
+            && vel_ecef_mps.norm() <= MAX_SAT_SPEED_MPS
+            && clock_bias_s.abs() <= MAX_SAT_CLOCK_BIAS_S
+            && clock_drift_s_s.abs() <= MAX_SAT_CLOCK_DRIFT_S_S;
+        if !plausible {
+            return None;
+        }
         Some(SatState {
             pos_ecef_m,
             vel_ecef_mps,
@@ -326,6 +334,20 @@ impl KeplerianEphemeris {
         }
     }
 }
+
+/// Bounds on a satellite state computed from broadcast elements; outside them the
+/// elements are corrupt (a decoding error, a crafted message) and the satellite is left
+/// out instead of putting a satellite at 1e59 m into the measurements.
+///
+/// Choice: every GNSS orbit has a semi-major axis between 25,500 km (GLONASS) and
+/// 42,200 km (GEO, IGSO) and an eccentricity below 0.1, so 20,000–50,000 km holds them
+/// all; ECEF speeds stay below 5 km/s (10 km/s allowed); the ICDs' a_f0 fields reach
+/// 0.06 s at most (Galileo) and a_f1 3.7e-9 s/s (GPS), bounded here by 1 s and 1e-6.
+const MIN_ORBIT_RADIUS_M: f64 = 2.0e7;
+const MAX_ORBIT_RADIUS_M: f64 = 5.0e7;
+const MAX_SAT_SPEED_MPS: f64 = 1.0e4;
+const MAX_SAT_CLOCK_BIAS_S: f64 = 1.0;
+const MAX_SAT_CLOCK_DRIFT_S_S: f64 = 1.0e-6;
 
 /// Eccentric anomaly from the mean anomaly by Newton's method on M = E − e sin E.
 fn solve_kepler(mean_anomaly_rad: f64, e: f64) -> f64 {
@@ -426,6 +448,28 @@ pub(crate) mod tests {
         // Over two hours E sweeps ~60°: the term reaches a good part of its bound (≈ 19.8 ns).
         assert!((bound_s - 19.77e-9).abs() < 0.05e-9, "{bound_s}");
         assert!(max_rel > 0.5 * bound_s);
+    }
+
+    #[test]
+    fn corrupt_but_finite_elements_give_no_satellite() {
+        let t = g32().toe.add_seconds(60.0);
+        assert!(g32().state_at(&t).is_some());
+        let corruptions: [fn(&mut KeplerianEphemeris); 5] = [
+            |e| e.sqrt_a_sqrt_m = 1e29,
+            |e| e.crs_m = 1e59,
+            |e| e.sqrt_a_sqrt_m = 100.0,
+            |e| e.af0_s = 1e3,
+            |e| e.af1_s_s = 1e-3,
+        ];
+        for (k, corrupt) in corruptions.iter().enumerate() {
+            let mut eph = g32();
+            corrupt(&mut eph);
+            assert!(
+                eph.is_valid(),
+                "corruption {k} is finite and passes is_valid"
+            );
+            assert_eq!(eph.state_at(&t), None, "corruption {k}");
+        }
     }
 
     fn central_difference(eph: &KeplerianEphemeris, t: &GpsTime) -> (Vector3<f64>, f64) {

@@ -13,6 +13,9 @@
 //! - Rate: ρ̇ = −λ · D (RINEX Doppler is positive for an approaching satellite). RINEX
 //!   carries no measurement σ: both σ fields are None. C/N0 is the `S` value as written
 //!   (dB-Hz in files by receivers' converters).
+//! - Carrier phase: the `L` value of the same band and attribute (cycles of the signal's
+//!   wavelength), its LLI bit 0 the loss of lock, bit 1 the unresolved half cycle; RINEX
+//!   has no lock time and no phase σ.
 
 use super::header::ObsCode;
 use super::record::{ObsEpoch, SatRecord};
@@ -20,7 +23,7 @@ use crate::gnss::ephemeris::{EphemerisStore, RangingCode, Signal};
 use crate::gnss::epoch_build::{
     complete_epoch, preferred_signals, unfilled_observation, BuiltEpoch, EpochStats,
 };
-use crate::gnss::{Klobuchar, SatObservation};
+use crate::gnss::{CarrierPhase, Klobuchar, SatObservation};
 
 /// RINEX 3 pseudo-range codes of `signal`, best first (empty: not read from RINEX).
 pub fn pseudorange_codes(signal: Signal) -> &'static [&'static str] {
@@ -88,9 +91,21 @@ fn observation(
     pseudorange_m: f64,
 ) -> SatObservation {
     let value = |kind: u8| record.get(code.with_type(kind)).map(|v| v.value);
+    let phase = record.get(code.with_type(b'L'));
     SatObservation {
         pseudorange_rate_mps: value(b'D').map(|d| -signal.wavelength_m() * d),
         cn0_dbhz: value(b'S'),
+        carrier_phase: phase.map(|p| {
+            let lli = p.lli.unwrap_or(0);
+            CarrierPhase {
+                cycles: p.value,
+                wavelength_m: Some(signal.wavelength_m()),
+                sigma_cycles: None,
+                lock_time_s: None,
+                loss_of_lock: lli & 0x01 != 0,
+                half_cycle_unresolved: lli & 0x02 != 0,
+            }
+        }),
         ..unfilled_observation(record.sat, pseudorange_m)
     }
 }

@@ -14,6 +14,13 @@
 //!   λ · σ_D; the pseudo-range σ is the receiver's prStdev.
 //! - A satellite with two measurement blocks of one signal (gnssId, svId, sigId), which
 //!   a receiver never outputs, is left out whole (counted as `duplicate_signals`).
+//! - Carrier phase: the first signal's cpMes when trkStat says it is valid, in cycles of
+//!   that signal's wavelength (also for an ionosphere-free pair, like the rate: a time
+//!   difference of it changes with the ionosphere by millimetres per second); σ from
+//!   cpStdev (0.004 cycles per step, none for step 0), the lock time from locktime. A
+//!   receiver clock reset (recStat) marks every phase of the epoch as a loss of lock; the
+//!   half cycle is unresolved while trkStat does not say "half cycle valid". RAWX has no
+//!   slip flag of its own: a slip shows as a lock time that restarted.
 
 use super::ids::{sat_id, signal};
 use super::rawx::{RawMeasurement, RawX};
@@ -22,7 +29,7 @@ use crate::gnss::epoch_build::{
     complete_epoch, preferred_signals, unfilled_observation, BuiltEpoch, EpochStats,
 };
 use crate::gnss::ionosphere::{iono_free_pairs, IonosphereMode};
-use crate::gnss::{Klobuchar, SatId, SatObservation};
+use crate::gnss::{CarrierPhase, Klobuchar, SatId, SatObservation};
 
 /// Builds the single-frequency epoch of `raw` ([`IonosphereMode::Broadcast`]).
 pub fn build_epoch(raw: &RawX, store: &EphemerisStore, klobuchar: Option<Klobuchar>) -> BuiltEpoch {
@@ -73,7 +80,7 @@ pub fn build_epoch_with(
             }
             continue;
         };
-        match observation(sat, code, m, second, mode) {
+        match observation(sat, code, m, second, mode, raw.clock_reset) {
             Some(obs) => candidates.push((code, obs)),
             None => stats.unsupported += 1,
         }
@@ -139,6 +146,7 @@ fn observation(
     m: &RawMeasurement,
     second: Option<&RawMeasurement>,
     mode: IonosphereMode,
+    clock_reset: bool,
 ) -> Option<SatObservation> {
     let lambda_m = code.primary().wavelength_m();
     let finite = |v: f64| v.is_finite().then_some(v);
@@ -157,6 +165,19 @@ fn observation(
         pseudorange_rate_sigma_mps: finite(lambda_m * m.doppler_sigma_hz),
         cn0_dbhz: Some(m.cn0_dbhz),
         iono_delay_m,
+        carrier_phase: carrier_phase(m, lambda_m, clock_reset),
         ..unfilled_observation(sat, pseudorange_m)
+    })
+}
+
+/// The carrier phase of `m` (wavelength `lambda_m`) when trkStat marks it valid.
+fn carrier_phase(m: &RawMeasurement, lambda_m: f64, clock_reset: bool) -> Option<CarrierPhase> {
+    (m.tracking.cp_valid && m.carrier_phase_cycles.is_finite()).then(|| CarrierPhase {
+        cycles: m.carrier_phase_cycles,
+        wavelength_m: Some(lambda_m),
+        sigma_cycles: (m.carrier_phase_sigma_cycles > 0.0).then_some(m.carrier_phase_sigma_cycles),
+        lock_time_s: Some(m.lock_time_s),
+        loss_of_lock: clock_reset,
+        half_cycle_unresolved: !m.tracking.half_cycle_valid,
     })
 }

@@ -35,18 +35,13 @@ impl RosAdapter {
                 self.imu_frame_conflict().unwrap_or(phase),
             ),
             Some(state) => {
-                // Filter health: the 3D position sigma the filter claims.
-                let sigma_m = state
-                    .solution()
-                    .position_covariance_enu_m2()
-                    .trace()
-                    .max(0.0)
-                    .sqrt();
+                let trace_m2 = state.solution().position_covariance_enu_m2().trace();
+                let sigma_m = position_sigma_3d_m(trace_m2);
                 values.push(key_value("position_sigma_3d_m", format!("{sigma_m:.3}")));
                 if !sigma_m.is_finite() {
                     (
                         DiagnosticStatus::ERROR,
-                        "filter covariance is not finite".to_owned(),
+                        "filter covariance is not finite and positive".to_owned(),
                     )
                 } else if let Some(conflict) = self.imu_frame_conflict() {
                     (DiagnosticStatus::WARN, conflict)
@@ -81,9 +76,34 @@ impl RosAdapter {
     }
 }
 
+/// The 3D position sigma the filter claims, from the trace of its ENU position covariance:
+/// NaN when the trace is NaN, infinite or negative, so that a broken covariance reports
+/// ERROR instead of a sigma of zero (`NaN.max(0.0)` is 0).
+fn position_sigma_3d_m(trace_m2: f64) -> f64 {
+    if trace_m2 >= 0.0 && trace_m2.is_finite() {
+        trace_m2.sqrt()
+    } else {
+        f64::NAN
+    }
+}
+
 fn key_value(key: &str, value: String) -> KeyValue {
     KeyValue {
         key: key.to_owned(),
         value,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::position_sigma_3d_m;
+
+    #[test]
+    fn a_broken_covariance_has_no_sigma() {
+        assert_eq!(position_sigma_3d_m(9.0), 3.0);
+        assert_eq!(position_sigma_3d_m(0.0), 0.0);
+        for trace in [f64::NAN, f64::INFINITY, -1e-6, f64::NEG_INFINITY] {
+            assert!(position_sigma_3d_m(trace).is_nan(), "trace {trace}");
+        }
     }
 }

@@ -25,6 +25,16 @@ pub enum BagError {
         /// Length of the file (bytes).
         len: u64,
     },
+    /// A rosbag2 bag in the sqlite3 storage (`.db3`), which this crate does not read.
+    #[error(
+        "{path}: a rosbag2 sqlite3 (.db3) bag; this tool reads MCAP bags: convert it with \
+         `ros2 bag convert -i BAG -o out.yaml` (out.yaml: `output_bags: [{{uri: BAG_mcap, \
+         storage_id: mcap}}]`) or with the `rosbags-convert` tool of the PyPI package rosbags"
+    )]
+    Sqlite3 {
+        /// The `.db3` file or the directory holding it.
+        path: PathBuf,
+    },
     /// A directory given as a bag does not hold exactly one `.mcap` file.
     #[error("{path}: a bag directory must hold exactly one .mcap file, found {found}")]
     BagDirectory {

@@ -61,6 +61,9 @@ pub struct BagReader {
     topics: Vec<TopicInfo>,
 }
 
+/// The header string at the start of every SQLite 3 database (rosbag2's `.db3`).
+const SQLITE_MAGIC: &[u8; 16] = b"SQLite format 3\0";
+
 /// MCAP magic bytes at the start of every MCAP file.
 const MCAP_MAGIC: &[u8] = mcap::MAGIC;
 
@@ -158,6 +161,7 @@ fn resolve_bag_file(path: &Path) -> Result<PathBuf, BagError> {
     let entries = std::fs::read_dir(path)
         .map_err(|source| BagError::io(path, "listing the bag directory", source))?;
     let mut files = Vec::new();
+    let mut has_db3 = false;
     for entry in entries {
         let entry =
             entry.map_err(|source| BagError::io(path, "listing the bag directory", source))?;
@@ -167,10 +171,15 @@ fn resolve_bag_file(path: &Path) -> Result<PathBuf, BagError> {
             .is_some_and(|extension| extension == "mcap")
         {
             files.push(file);
+        } else if file.extension().is_some_and(|extension| extension == "db3") {
+            has_db3 = true;
         }
     }
     match files.as_slice() {
         [single] => Ok(single.clone()),
+        [] if has_db3 => Err(BagError::Sqlite3 {
+            path: path.to_path_buf(),
+        }),
         _ => Err(BagError::BagDirectory {
             path: path.to_path_buf(),
             found: files.len(),
@@ -192,6 +201,14 @@ fn check_magic(path: &Path, file: &mut File) -> Result<(), BagError> {
     let mut magic = [0_u8; 8];
     let starts_with_magic = file.read_exact(&mut magic).is_ok() && magic == MCAP_MAGIC;
     if !starts_with_magic {
+        let mut sqlite = [0_u8; 16];
+        sqlite[..8].copy_from_slice(&magic);
+        let is_sqlite = file.read_exact(&mut sqlite[8..]).is_ok() && &sqlite == SQLITE_MAGIC;
+        if is_sqlite {
+            return Err(BagError::Sqlite3 {
+                path: path.to_path_buf(),
+            });
+        }
         return Err(BagError::NotMcap {
             path: path.to_path_buf(),
             len,

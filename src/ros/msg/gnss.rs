@@ -44,6 +44,16 @@ pub struct SatelliteMeasurement {
     pub ionosphere_delay_m: f64,
     /// Tropospheric delay on the pseudo-range (m); NaN: the node models it.
     pub troposphere_delay_m: f64,
+    /// Carrier phase (cycles), with the sign of the pseudo-range; NaN when not tracked.
+    pub carrier_phase_cycles: f64,
+    /// Wavelength of the carrier (m); NaN when unknown.
+    pub carrier_wavelength_m: f64,
+    /// Receiver-reported 1σ of the carrier phase (cycles); NaN when unknown.
+    pub carrier_phase_sigma_cycles: f64,
+    /// Time lock has been kept on the carrier (s); NaN when unknown.
+    pub carrier_lock_time_s: f64,
+    /// `CARRIER_*` bits.
+    pub carrier_phase_flags: u8,
 }
 ros_message!(
     SatelliteMeasurement,
@@ -64,6 +74,10 @@ impl SatelliteMeasurement {
     pub const QZSS: u8 = 5;
     /// SBAS geostationary satellites.
     pub const SBAS: u8 = 6;
+    /// `carrier_phase_flags`: lock lost since the previous epoch (a cycle slip is possible).
+    pub const CARRIER_LOSS_OF_LOCK: u8 = 1;
+    /// `carrier_phase_flags`: the half-cycle ambiguity is not resolved.
+    pub const CARRIER_HALF_CYCLE_UNRESOLVED: u8 = 2;
 }
 
 /// `adaptive_gnss_ins/msg/GnssMeasurements`: all raw measurements of one receiver epoch.
