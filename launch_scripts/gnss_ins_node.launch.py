@@ -15,9 +15,9 @@ Arguments:
 - imu_topic, gnss_topic, fix_topic, velocity_topic, odometry_topic: remappings of the
   node's relative topics imu, gnss/measurements, gnss/fix, gnss/velocity and odometry;
 - the node's own parameters use_sim_time (bool), map_frame, base_frame (frame ids),
-  publish_tf (bool) and queue_depth (int). Their default is '' meaning "not set": the
-  value then comes from the params file or, when the file has none, from the node's
-  default (false, map, base_link, false, 200). Choice: a parameters dict given after the
+  publish_tf (bool), queue_depth (int) and imu_frame (a frame id). Their default is ''
+  meaning "not set": the value then comes from the params file or, when the file has
+  none, from the node's default (false, map, base_link, false, 200, '' = learnt). Choice: a parameters dict given after the
   params file overrides it, so only the arguments the user set are passed; a default that
   is always passed would silently override the params file.
 - with_ubx_adapter (default false): also start gnss_ins_ubx_node (named ubx_node_name),
@@ -52,6 +52,7 @@ NODE_PARAMETERS = {
     'base_frame': (str, 'body frame: odometry child and fix frame (node default: base_link)'),
     'publish_tf': (bool, 'publish map_frame -> base_frame on /tf (node default: false)'),
     'queue_depth': (int, 'history depth of subscriptions and publishers (node default: 200)'),
+    'imu_frame': (str, 'the IMU frame_id; others are dropped (node default: learnt)'),
 }
 
 # gnss_ins_ubx_node's own parameters (src/ros/ubx_node/params.rs, UBX_NODE_PARAMETERS)

@@ -16,7 +16,10 @@
 //!   offline replay of the same data).
 //! - A measurement older than the last IMU sample (late delivery) rolls the filter back to
 //!   the last stored state before it, applies it, and re-integrates the buffered IMU
-//!   samples; one older than `engine.imu_buffer_s` is rejected and counted.
+//!   samples; one older than `engine.imu_buffer_s` is rejected and counted, and so is one
+//!   more than `engine.imu_buffer_s` ahead of the IMU.
+//! - Every buffer is bounded by count as well as by time ([`MAX_BUFFERED_IMU_SAMPLES`],
+//!   [`MAX_PENDING_MEASUREMENTS`]), so no input rate or stamp grows memory without bound.
 //! - Start-up (`initializer`): levelled at rest, or aligned in motion from GNSS when
 //!   the IMU's window is not at rest (a start or a restart mid-drive); a start whose
 //!   heading is too uncertain for one filter runs a bank of heading hypotheses first
@@ -60,6 +63,34 @@ pub use output::{
 pub use rejection::{InputRejected, RejectionCounters, RejectionReason};
 pub use retune::{NotRuntimeTunable, RUNTIME_PARAMETERS};
 pub use update::GnssFix;
+
+/// Most IMU samples buffered, and filter states stored after them, whatever
+/// `engine.imu_buffer_s` says.
+///
+/// Choice: 10,000: 10 s of a 1 kHz IMU, the default 2 s of a 5 kHz one. Samples stamped
+/// microseconds apart (a flood, a broken clock) would otherwise fill the time window with
+/// millions of states; with the bound the buffers hold at most some 35 MB (a stored state
+/// is about 3.5 KB, most of it the 20×20 covariance). Where it binds, a late measurement
+/// reaches back less far than `engine.imu_buffer_s` (rejected as too old, counted).
+pub const MAX_BUFFERED_IMU_SAMPLES: usize = 10_000;
+
+/// Most measurements waiting for the IMU to pass their time.
+///
+/// Choice: 100, 10 s of a 10 Hz receiver: a measurement waits only until the IMU passes
+/// its stamp, which is at most `engine.imu_buffer_s` ahead (a later one is rejected), so
+/// only a stream without IMU fills the queue; the oldest then leaves, counted.
+pub const MAX_PENDING_MEASUREMENTS: usize = 100;
+
+/// The sizes of the engine's buffers (see [`Engine::buffered`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Buffered {
+    /// IMU samples kept for roll-backs.
+    pub imu_samples: usize,
+    /// Filter states stored after them.
+    pub states: usize,
+    /// Measurements waiting for the IMU.
+    pub measurements: usize,
+}
 
 /// A measurement waiting for its time.
 #[derive(Debug, Clone, PartialEq)]
@@ -171,6 +202,16 @@ impl Engine {
         }
     }
 
+    /// The sizes of the buffers, each bounded ([`MAX_BUFFERED_IMU_SAMPLES`],
+    /// [`MAX_PENDING_MEASUREMENTS`]).
+    pub fn buffered(&self) -> Buffered {
+        Buffered {
+            imu_samples: self.imu.len(),
+            states: self.history.len(),
+            measurements: self.pending.len(),
+        }
+    }
+
     /// Time of the last accepted IMU sample.
     pub fn last_imu_t_s(&self) -> Option<f64> {
         self.imu.back().map(|s| s.t_s)
@@ -255,13 +296,17 @@ impl Engine {
         self.standstill.push(&body);
         self.imu.push_back(body);
         let horizon = body.t_s - self.config.engine.imu_buffer_s;
-        while self.imu.front().is_some_and(|s| s.t_s < horizon) && self.imu.len() > 2 {
+        while self.imu.len() > MAX_BUFFERED_IMU_SAMPLES
+            || self.imu.front().is_some_and(|s| s.t_s < horizon) && self.imu.len() > 2
+        {
             self.imu.pop_front();
         }
-        while self
-            .history
-            .front()
-            .is_some_and(|s| s.state.last_imu.t_s < horizon)
+        // Room for the state after this sample.
+        while self.history.len() >= MAX_BUFFERED_IMU_SAMPLES
+            || self
+                .history
+                .front()
+                .is_some_and(|s| s.state.last_imu.t_s < horizon)
         {
             self.history.pop_front();
         }
@@ -319,6 +364,11 @@ impl Engine {
                 .counters
                 .reject(RejectionReason::MeasurementDuplicate, t));
         }
+        if t > last_t + self.config.engine.imu_buffer_s {
+            // Choice: a measurement may wait for the IMU as long as a late one may reach
+            // back; one further ahead (a bad stamp) would wait, and hold memory, forever.
+            return Err(self.counters.reject(RejectionReason::MeasurementTooNew, t));
+        }
         if t >= last_t {
             self.enqueue(m, false);
             return Ok(Vec::new());
@@ -359,6 +409,11 @@ impl Engine {
     }
 
     fn enqueue(&mut self, measurement: Measurement, reported: bool) {
+        if self.pending.len() >= MAX_PENDING_MEASUREMENTS {
+            let oldest = self.pending.remove(0).measurement.t_s();
+            self.counters
+                .reject(RejectionReason::MeasurementQueueFull, oldest);
+        }
         let t = measurement.t_s();
         let at = self.pending.partition_point(|p| p.measurement.t_s() <= t);
         self.pending.insert(

@@ -226,6 +226,8 @@ pub enum ResetReason {
     TimeJumpBackwards,
     /// A measurement update produced a non-finite state.
     Diverged,
+    /// The IMU stream moved to another `frame_id` (another sensor), handled by the caller.
+    ImuFrameChanged,
 }
 
 /// Everything the engine emits.

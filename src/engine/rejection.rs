@@ -31,6 +31,10 @@ pub enum RejectionReason {
     MeasurementDuplicate,
     /// A measurement older than the IMU buffer (`engine.imu_buffer_s`).
     MeasurementTooOld,
+    /// A measurement more than `engine.imu_buffer_s` ahead of the last IMU sample.
+    MeasurementTooNew,
+    /// A waiting measurement dropped for a newer one: the queue was full (no IMU came).
+    MeasurementQueueFull,
     /// A pseudo-range epoch in loosely-coupled mode, or a fix in tightly-coupled mode.
     WrongCoupling,
     /// The Kalman update failed (singular or non-finite); the state was kept.
@@ -53,6 +57,8 @@ impl RejectionReason {
             Self::FixNotFinite => "fix_not_finite",
             Self::MeasurementDuplicate => "measurement_duplicate",
             Self::MeasurementTooOld => "measurement_too_old",
+            Self::MeasurementTooNew => "measurement_too_new",
+            Self::MeasurementQueueFull => "measurement_queue_full",
             Self::WrongCoupling => "wrong_coupling",
             Self::UpdateFailed => "update_failed",
         }

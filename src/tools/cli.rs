@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use clap::{Subcommand, ValueEnum};
 
 use crate::config::{Config, Coupling, FilterVariant};
-use crate::ros::adapter::{OutputFrames, TIME_JUMP_BACK_S};
+use crate::ros::adapter::{OutputFrames, TIME_JUMP_BACK_S, TIME_JUMP_CONFIRM_SAMPLES};
 use crate::ros::bag::ChunkCompression;
 use crate::sim::{Scenario, ScenarioSpec};
 
@@ -367,7 +367,8 @@ fn print_problems(run: &BagRun, coupling: Coupling) {
     if run.counts.time_jump_resets > 0 {
         eprintln!(
             "warning: the filter was reset and started again {} time(s): the IMU time jumped \
-             back more than {TIME_JUMP_BACK_S} s (time_jump_resets)",
+             back more than {TIME_JUMP_BACK_S} s for {TIME_JUMP_CONFIRM_SAMPLES} samples in a \
+             row (time_jump_resets)",
             run.counts.time_jump_resets
         );
     }

@@ -49,20 +49,30 @@ pub struct InputCounts {
     pub unconvertible_fix: u64,
     /// Velocities with a bad stamp or a non-finite value.
     pub unconvertible_velocity: u64,
-    /// Resets because the IMU time jumped backwards.
+    /// Resets because the IMU time jumped backwards (several consecutive samples agreed).
     pub time_jump_resets: u64,
+    /// IMU samples whose stamp was far off the time line and that no run of consecutive
+    /// samples confirmed (a spoofed or corrupted stamp): dropped.
+    pub imu_stamp_outliers: u64,
     /// Outputs not published because a value was not finite.
     pub non_finite_outputs: u64,
     /// Outputs not published because a covariance had a negative variance.
     pub negative_variance_outputs: u64,
-    /// IMU messages from another frame than the first accepted one (a second publisher).
+    /// IMU messages from another frame than the locked one (a second publisher).
     pub foreign_frame_imu: u64,
-    /// GnssMeasurements messages from another frame than the first accepted one.
+    /// GnssMeasurements messages from another frame than the locked one.
     pub foreign_frame_gnss: u64,
-    /// NavSatFix messages from another frame than the first accepted one.
+    /// NavSatFix messages from another frame than the locked one.
     pub foreign_frame_fix: u64,
     /// Velocities neither in the map frame nor in their fix's frame (fix used without).
     pub foreign_frame_velocity: u64,
+    /// Times the IMU stream's learnt frame moved to another one (the locked frame went
+    /// silent; the filter reset).
+    pub frame_switches_imu: u64,
+    /// Times the GnssMeasurements stream's learnt frame moved to another one.
+    pub frame_switches_gnss: u64,
+    /// Times the NavSatFix stream's learnt frame moved to another one.
+    pub frame_switches_fix: u64,
 }
 
 impl InputCounts {
@@ -86,11 +96,22 @@ impl InputCounts {
         }
     }
 
-    /// The messages dropped before the engine that decoded: (name, count) of the ones that
-    /// did not convert and the ones from a foreign frame (a velocity in a foreign frame
-    /// drops no message: its fix goes on alone), named as on /diagnostics.
-    pub fn dropped(&self) -> [(&'static str, u64); 7] {
+    /// The frame-switch counter of `input` (velocities follow their fix's frame).
+    pub(super) fn frame_switches(&mut self, input: Input) -> &mut u64 {
+        match input {
+            Input::Imu => &mut self.frame_switches_imu,
+            Input::Gnss => &mut self.frame_switches_gnss,
+            Input::Fix | Input::Velocity => &mut self.frame_switches_fix,
+        }
+    }
+
+    /// The messages dropped before the engine that decoded: (name, count) of the IMU
+    /// stamp outliers, the ones that did not convert and the ones from a foreign frame (a
+    /// velocity in a foreign frame drops no message: its fix goes on alone), named as on
+    /// /diagnostics.
+    pub fn dropped(&self) -> [(&'static str, u64); 8] {
         [
+            ("imu_stamp_outliers", self.imu_stamp_outliers),
             ("unconvertible_imu", self.unconvertible_imu),
             ("unconvertible_gnss", self.unconvertible_gnss),
             ("unconvertible_fix", self.unconvertible_fix),
@@ -103,7 +124,7 @@ impl InputCounts {
 
     /// The counters as (name, value) in the order of the /diagnostics report; the names
     /// are the report's keys.
-    pub fn named(&self) -> [(&'static str, u64); 17] {
+    pub fn named(&self) -> [(&'static str, u64); 21] {
         [
             ("imu_received", self.imu_received),
             ("gnss_received", self.gnss_received),
@@ -116,12 +137,16 @@ impl InputCounts {
             ("unconvertible_fix", self.unconvertible_fix),
             ("unconvertible_velocity", self.unconvertible_velocity),
             ("time_jump_resets", self.time_jump_resets),
+            ("imu_stamp_outliers", self.imu_stamp_outliers),
             ("non_finite_outputs", self.non_finite_outputs),
             ("negative_variance_outputs", self.negative_variance_outputs),
             ("foreign_frame_imu", self.foreign_frame_imu),
             ("foreign_frame_gnss", self.foreign_frame_gnss),
             ("foreign_frame_fix", self.foreign_frame_fix),
             ("foreign_frame_velocity", self.foreign_frame_velocity),
+            ("frame_switches_imu", self.frame_switches_imu),
+            ("frame_switches_gnss", self.frame_switches_gnss),
+            ("frame_switches_fix", self.frame_switches_fix),
         ]
     }
 }

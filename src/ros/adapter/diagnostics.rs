@@ -6,7 +6,8 @@ use super::RosAdapter;
 
 impl RosAdapter {
     /// The /diagnostics report at `stamp`: input counts, rejections by reason, phase and,
-    /// once running, the filter's 3D position sigma (level ERROR when it is not finite).
+    /// once running, the filter's 3D position sigma (level ERROR when it is not finite);
+    /// level WARN while initializing or while a second frame sends on `imu`.
     pub fn diagnostics(&self, node_name: &str, stamp: Time) -> DiagnosticArray {
         let phase = match self.engine.init_phase() {
             Some(p) => format!("initializing ({p:?})"),
@@ -15,6 +16,7 @@ impl RosAdapter {
         let mut values = vec![
             key_value("variant", self.engine.variant_name().to_owned()),
             key_value("phase", phase.clone()),
+            key_value("imu_frame", self.imu_frame.locked().to_owned()),
         ];
         for (key, n) in self.counts.named() {
             values.push(key_value(key, n.to_string()));
@@ -28,18 +30,23 @@ impl RosAdapter {
             value: n.to_string(),
         }));
         let (level, message) = match self.engine.state() {
-            None => (DiagnosticStatus::WARN, phase),
+            None => (
+                DiagnosticStatus::WARN,
+                self.imu_frame_conflict().unwrap_or(phase),
+            ),
             Some(state) => {
                 let trace_m2 = state.solution().position_covariance_enu_m2().trace();
                 let sigma_m = position_sigma_3d_m(trace_m2);
                 values.push(key_value("position_sigma_3d_m", format!("{sigma_m:.3}")));
-                if sigma_m.is_finite() {
-                    (DiagnosticStatus::OK, phase)
-                } else {
+                if !sigma_m.is_finite() {
                     (
                         DiagnosticStatus::ERROR,
                         "filter covariance is not finite and positive".to_owned(),
                     )
+                } else if let Some(conflict) = self.imu_frame_conflict() {
+                    (DiagnosticStatus::WARN, conflict)
+                } else {
+                    (DiagnosticStatus::OK, phase)
                 }
             }
         };
@@ -56,6 +63,16 @@ impl RosAdapter {
                 values,
             }],
         }
+    }
+
+    /// The message telling that another frame sent on `imu` lately, if one did.
+    fn imu_frame_conflict(&self) -> Option<String> {
+        self.imu_frame.conflict().map(|other| {
+            format!(
+                "imu: messages from frame `{other}` besides the followed `{}` (a second publisher?)",
+                self.imu_frame.locked()
+            )
+        })
     }
 }
 

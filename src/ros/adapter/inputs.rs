@@ -1,4 +1,4 @@
-//! Decoded input messages into the engine: conversion, frame locks, the time-jump rule and
+//! Decoded input messages into the engine: conversion, frame locks, the IMU time line and
 //! the fix / velocity join; what is dropped is counted and logged (rate-limited).
 
 use crate::engine::{GnssFix, Output, ResetReason};
@@ -8,13 +8,9 @@ use crate::ros::convert::GnssVelocity;
 use crate::ros::fix_velocity::{FramedFix, Joined, VelocityUse};
 use crate::ros::msg::{GnssMeasurements, Imu, NavSatFix, TwistWithCovarianceStamped};
 
+use super::frame_lock::Admission;
+use super::time_line::Verdict;
 use super::{Input, Published, RosAdapter};
-
-/// Choice: an IMU stamp more than this much older than the last accepted one is a time
-/// jump (a bag played in a loop, or the samples after one stamped far ahead) and resets
-/// the filter; smaller steps back are ordinary out-of-order samples the engine rejects.
-/// 1 s is far beyond any transport reordering.
-pub const TIME_JUMP_BACK_S: f64 = 1.0;
 
 /// A decoded message on one of the adapter's input streams.
 #[derive(Debug, Clone, PartialEq)]
@@ -52,31 +48,55 @@ impl RosAdapter {
             Ok(s) => s,
             Err(e) => return self.unconvertible(Input::Imu, &e.to_string()),
         };
-        if !self.imu_frame.admits(&msg.header.frame_id) {
-            return self.foreign_frame(Input::Imu, &msg.header.frame_id);
-        }
+        let frame_id = &msg.header.frame_id;
         let mut outputs = Vec::new();
-        if let Some(last_t_s) = self.engine.last_imu_t_s() {
-            if sample.t_s < last_t_s - TIME_JUMP_BACK_S {
-                self.counts.time_jump_resets += 1;
-                log::warn!(
-                    "IMU time jumped back from {last_t_s:.3} s to {:.3} s: resetting the filter",
-                    sample.t_s
-                );
-                outputs.push(
-                    self.engine
-                        .reset(sample.t_s, ResetReason::TimeJumpBackwards),
-                );
+        match self.imu_frame.admit(frame_id) {
+            Admission::Admitted => {}
+            Admission::Foreign => return self.foreign_frame(Input::Imu, frame_id),
+            Admission::Switched => {
+                self.frame_switched(Input::Imu, frame_id);
+                // Another sensor: its samples share nothing with the old one's.
+                let reset = self.engine.reset(sample.t_s, ResetReason::ImuFrameChanged);
+                outputs.push(reset);
                 self.pairing.clear();
             }
         }
+        let last_t_s = self.engine.last_imu_t_s();
+        let max_gap_s = self.engine.config().engine.max_imu_gap_s;
+        let outliers = &mut self.counts.imu_stamp_outliers;
+        match self.time_line.judge(&sample, last_t_s, max_gap_s, outliers) {
+            Verdict::OnLine => self.feed_imu(&sample, frame_id, &mut outputs),
+            Verdict::Held => {}
+            Verdict::Jumped(run) => {
+                let to_t_s = run.first().map_or(f64::NAN, |s| s.t_s);
+                if let Some(from_t_s) = last_t_s.filter(|&from_t_s| to_t_s < from_t_s) {
+                    self.counts.time_jump_resets += 1;
+                    self.log.warn(
+                        "time jump",
+                        &format!("IMU time jumped back from {from_t_s:.3} s to {to_t_s:.3} s: resetting the filter"),
+                    );
+                    let reset = self.engine.reset(to_t_s, ResetReason::TimeJumpBackwards);
+                    outputs.push(reset);
+                    self.pairing.clear();
+                }
+                // A jump ahead is a gap: the engine resets on the first sample.
+                for s in &run {
+                    self.feed_imu(s, frame_id, &mut outputs);
+                }
+            }
+        }
+        self.publishable(outputs)
+    }
+
+    /// Feeds one sample of `frame_id` after the fixes the join releases at its time.
+    fn feed_imu(&mut self, sample: &ImuSample, frame_id: &str, outputs: &mut Vec<Output>) {
         let released = self.pairing.on_time(sample.t_s);
-        self.push_fixes(released, &mut outputs);
-        match self.engine.push_imu(&sample) {
+        self.push_fixes(released, outputs);
+        match self.engine.push_imu(sample) {
             Ok(o) => {
-                self.imu_frame.accepted(&msg.header.frame_id);
+                self.imu_frame.accepted(frame_id);
                 if outputs.is_empty() {
-                    outputs = o;
+                    *outputs = o;
                 } else {
                     outputs.extend(o);
                 }
@@ -85,7 +105,6 @@ impl RosAdapter {
                 self.log.warn(e.reason.name(), &format!("imu: {e}"));
             }
         }
-        self.publishable(outputs)
     }
 
     /// Handles one GnssMeasurements (tight coupling).
@@ -95,8 +114,10 @@ impl RosAdapter {
             Ok(e) => e,
             Err(e) => return self.unconvertible(Input::Gnss, &e.to_string()),
         };
-        if !self.gnss_frame.admits(&msg.header.frame_id) {
-            return self.foreign_frame(Input::Gnss, &msg.header.frame_id);
+        match self.gnss_frame.admit(&msg.header.frame_id) {
+            Admission::Admitted => {}
+            Admission::Foreign => return self.foreign_frame(Input::Gnss, &msg.header.frame_id),
+            Admission::Switched => self.frame_switched(Input::Gnss, &msg.header.frame_id),
         }
         let outputs = match self.engine.push_gnss(epoch) {
             Ok(o) => {
@@ -119,8 +140,10 @@ impl RosAdapter {
             Ok(f) => f,
             Err(e) => return self.unconvertible(Input::Fix, &e.to_string()),
         };
-        if !self.fix_frame.admits(&msg.header.frame_id) {
-            return self.foreign_frame(Input::Fix, &msg.header.frame_id);
+        match self.fix_frame.admit(&msg.header.frame_id) {
+            Admission::Admitted => {}
+            Admission::Foreign => return self.foreign_frame(Input::Fix, &msg.header.frame_id),
+            Admission::Switched => self.frame_switched(Input::Fix, &msg.header.frame_id),
         }
         let released = self.pairing.on_fix(FramedFix {
             fix,
@@ -206,5 +229,13 @@ impl RosAdapter {
             &format!("dropped a message on {name} from frame `{frame_id}`: the node follows {expected} (a second publisher?)"),
         );
         Vec::new()
+    }
+
+    /// Counts and logs that the stream of `input` now follows `frame_id` (its locked frame
+    /// went silent).
+    fn frame_switched(&mut self, input: Input, frame_id: &str) {
+        *self.counts.frame_switches(input) += 1;
+        let name = input.name();
+        log::warn!("{name}: the locked frame went silent; now following frame `{frame_id}`");
     }
 }

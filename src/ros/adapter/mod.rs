@@ -5,7 +5,8 @@
 //! and count what they drop by the same code.
 //!
 //! Data flow of one IMU sample: `sensor_msgs/Imu` → [`RosAdapter::on_imu`] (conversion
-//! [`ImuSample::try_from`](crate::ins::ImuSample), frame lock, time-jump rule, the fixes
+//! [`ImuSample::try_from`](crate::ins::ImuSample), frame lock, time line (a stamp far off
+//! it is dropped, a sustained jump resets), the fixes
 //! the join releases at this IMU time) → [`Engine::push_imu`] (mechanization and
 //! covariance propagation, a [`Solution`](crate::engine::Solution) per sample or at
 //! `output.rate_hz`) → `outputs` (the guard: every number finite, no negative variance;
@@ -31,6 +32,7 @@ mod inputs;
 mod outputs;
 #[cfg(test)]
 mod tests;
+mod time_line;
 
 use crate::config::Config;
 use crate::engine::{Engine, NotRuntimeTunable};
@@ -39,8 +41,10 @@ use crate::ros::fix_velocity::FixVelocityJoin;
 use crate::ros::log_limit::LogLimiter;
 pub use counts::{Input, InputCounts};
 use frame_lock::FrameLock;
-pub use inputs::{InputMessage, TIME_JUMP_BACK_S};
+pub use inputs::InputMessage;
 pub use outputs::{OutputFrames, Published, PublishedEpoch, PublishedSolution, SolutionMessages};
+use time_line::TimeLine;
+pub use time_line::{TIME_JUMP_BACK_S, TIME_JUMP_CONFIRM_SAMPLES};
 
 /// The engine with the node's message handling; see the module documentation.
 pub struct RosAdapter {
@@ -48,6 +52,7 @@ pub struct RosAdapter {
     counts: InputCounts,
     log: LogLimiter,
     imu_frame: FrameLock,
+    time_line: TimeLine,
     gnss_frame: FrameLock,
     fix_frame: FrameLock,
     pairing: FixVelocityJoin,
@@ -64,6 +69,7 @@ impl RosAdapter {
             counts: InputCounts::default(),
             log: LogLimiter::default(),
             imu_frame: FrameLock::default(),
+            time_line: TimeLine::default(),
             gnss_frame: FrameLock::default(),
             fix_frame: FrameLock::default(),
         }
@@ -74,6 +80,13 @@ impl RosAdapter {
     /// into messages, which would cost a run of the filter about a sixth more.
     pub fn without_messages(mut self) -> Self {
         self.outputs.without_messages();
+        self
+    }
+
+    /// The adapter that admits IMU samples from `frame_id` only (the node's `imu_frame`),
+    /// instead of learning the IMU's frame from the stream.
+    pub fn with_imu_frame(mut self, frame_id: &str) -> Self {
+        self.imu_frame = FrameLock::configured(frame_id);
         self
     }
 

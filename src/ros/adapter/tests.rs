@@ -6,7 +6,7 @@ use super::*;
 use crate::engine::RejectionReason;
 use crate::ins::ImuSample;
 use crate::ros::convert::seconds_to_time;
-use crate::ros::msg::{Imu, NavSatFix, Time, TwistWithCovarianceStamped};
+use crate::ros::msg::{DiagnosticStatus, Imu, NavSatFix, Time, TwistWithCovarianceStamped};
 use crate::ros::outbound;
 
 fn imu_at(t_s: f64) -> Imu {
@@ -177,11 +177,17 @@ fn loose_adapter(frames: OutputFrames) -> RosAdapter {
 
 /// Calls `on_event` with the static scenario's events of its first 30 s, each with its
 /// stamp.
-fn for_each_static_event_30_s(mut on_event: impl FnMut(crate::sim::SimEvent, Time)) {
+fn for_each_static_event_30_s(on_event: impl FnMut(crate::sim::SimEvent, Time)) {
+    for_each_static_event(30.0, on_event);
+}
+
+/// Calls `on_event` with the static scenario's events up to `until_s`, each with its
+/// stamp.
+fn for_each_static_event(until_s: f64, mut on_event: impl FnMut(crate::sim::SimEvent, Time)) {
     let scenario = crate::sim::Scenario::builtin("static", 5).unwrap();
     for event in scenario.events() {
         let event = event.unwrap();
-        if event.t_s() > 30.0 {
+        if event.t_s() > until_s {
             break;
         }
         let stamp = seconds_to_time(event.t_s()).unwrap();
@@ -328,4 +334,253 @@ fn a_paired_velocity_reaches_the_filter() {
     eprintln!("speed after 30 s: {honest:.3} m/s at rest, {biased:.3} m/s with the 1 m/s claim");
     assert!(honest < 0.1, "at rest: {honest} m/s");
     assert!(biased > 0.5, "following the claimed 1 m/s: {biased} m/s");
+}
+
+/// Runs the static scenario for `until_s` through a loose adapter, the IMU in frame `imu`;
+/// `before_imu` is called with each IMU sample before it is sent (to send others first).
+/// The number of solutions published.
+fn run_static(
+    adapter: &mut RosAdapter,
+    until_s: f64,
+    mut before_imu: impl FnMut(&mut RosAdapter, &ImuSample),
+) -> usize {
+    use crate::sim::SimEvent;
+    let mut solutions = 0;
+    for_each_static_event(until_s, |event, stamp| {
+        let out = match event {
+            SimEvent::Imu(s) => {
+                before_imu(adapter, &s);
+                adapter.on_imu(&outbound::imu(&s, stamp, "imu"))
+            }
+            SimEvent::Fix(f) => adapter.on_fix(&outbound::receiver_fix(&f, stamp, "gnss")),
+            _ => Vec::new(),
+        };
+        solutions += out
+            .iter()
+            .filter(|m| matches!(m, Published::Solution(_)))
+            .count();
+    });
+    solutions
+}
+
+/// `sample` restamped at `t_s` as an Imu message of `frame_id`.
+fn imu_message(sample: &ImuSample, t_s: f64, frame_id: &str) -> Imu {
+    let sample = ImuSample { t_s, ..*sample };
+    outbound::imu(&sample, seconds_to_time(t_s).unwrap(), frame_id)
+}
+
+fn level(adapter: &RosAdapter) -> (u8, String) {
+    let d = adapter.diagnostics("/n", Time::default());
+    (d.status[0].level, d.status[0].message.clone())
+}
+
+#[test]
+fn stray_imu_samples_sent_first_do_not_lock_out_the_imu() {
+    // Issue 12, item 10: five samples of another frame before the real IMU locked the
+    // node onto that frame for good.
+    let mut adapter = loose_adapter(OutputFrames::default());
+    let mut strays = 0;
+    let solutions = run_static(&mut adapter, 60.0, |adapter, s| {
+        while strays < 5 {
+            let t_s = s.t_s + 0.001 * f64::from(strays);
+            adapter.on_imu(&imu_message(s, t_s, "stray"));
+            strays += 1;
+        }
+    });
+    let c = adapter.counts();
+    assert_eq!(c.frame_switches_imu, 1);
+    assert!(
+        c.foreign_frame_imu > 0 && c.foreign_frame_imu < 1000,
+        "the real IMU waited {} samples",
+        c.foreign_frame_imu
+    );
+    assert_eq!(adapter.engine().init_phase(), None, "running");
+    assert!(solutions > 2000, "{solutions} solutions");
+    assert_eq!(diagnostic(&adapter, "imu_frame").as_deref(), Some("imu"));
+    assert_eq!(
+        diagnostic(&adapter, "frame_switches_imu").as_deref(),
+        Some("1")
+    );
+    assert_eq!(
+        level(&adapter).0,
+        DiagnosticStatus::OK,
+        "the conflict is over"
+    );
+}
+
+#[test]
+fn a_configured_imu_frame_admits_no_other_and_reports_the_conflict() {
+    let mut adapter = loose_adapter(OutputFrames::default()).with_imu_frame("imu");
+    let mut n = 0u64;
+    let mut strays = 0;
+    let solutions = run_static(&mut adapter, 30.0, |adapter, s| {
+        // A stray publisher: first, and then once every ten samples.
+        if n % 10 == 0 {
+            adapter.on_imu(&imu_message(s, s.t_s + 0.0005, "stray"));
+            strays += 1;
+        }
+        n += 1;
+    });
+    assert_eq!(adapter.counts().foreign_frame_imu, strays);
+    assert_eq!(adapter.counts().frame_switches_imu, 0);
+    assert_eq!(adapter.engine().init_phase(), None, "running");
+    assert!(solutions > 2000, "{solutions} solutions");
+    let (level, message) = level(&adapter);
+    assert_eq!(level, DiagnosticStatus::WARN);
+    assert!(
+        message.contains("`stray`") && message.contains("`imu`"),
+        "{message}"
+    );
+    // Without a configured frame the live IMU keeps its lock against the same stray.
+    let mut adapter = loose_adapter(OutputFrames::default());
+    n = 0;
+    run_static(&mut adapter, 30.0, |adapter, s| {
+        if n % 10 == 0 && n > 0 {
+            adapter.on_imu(&imu_message(s, s.t_s + 0.0005, "stray"));
+        }
+        n += 1;
+    });
+    assert_eq!(adapter.counts().frame_switches_imu, 0);
+    assert_eq!(adapter.engine().init_phase(), None, "running");
+}
+
+#[test]
+fn single_spoofed_stamps_are_dropped_and_counted_not_reset() {
+    // Issue 12, item 11: one sample 1.5 s in the past, or far in the future, reset the
+    // filter; one a second kept it from ever running.
+    let mut adapter = loose_adapter(OutputFrames::default());
+    let mut next_spoof_s = 2.0;
+    let mut spoofs = 0;
+    let solutions = run_static(&mut adapter, 60.0, |adapter, s| {
+        if s.t_s >= next_spoof_s {
+            let t_s = if spoofs % 2 == 0 {
+                s.t_s - 1.5
+            } else {
+                s.t_s + 1e6
+            };
+            adapter.on_imu(&imu_message(s, t_s, "imu"));
+            spoofs += 1;
+            next_spoof_s += 1.0;
+        }
+    });
+    assert!(spoofs >= 58, "{spoofs} spoofed stamps");
+    assert_eq!(adapter.counts().time_jump_resets, 0);
+    assert_eq!(adapter.counts().imu_stamp_outliers, spoofs);
+    let counters = adapter.engine().counters();
+    assert_eq!(counters.count(RejectionReason::ImuGap), 0);
+    assert_eq!(counters.count(RejectionReason::ImuOutOfOrder), 0);
+    assert_eq!(adapter.engine().init_phase(), None, "running");
+    assert!(solutions > 4000, "{solutions} solutions");
+    assert_eq!(
+        diagnostic(&adapter, "imu_stamp_outliers"),
+        Some(spoofs.to_string())
+    );
+}
+
+#[test]
+fn a_sustained_time_jump_resets_once_and_loses_no_sample() {
+    let mut adapter = RosAdapter::new(Config::default(), OutputFrames::default());
+    feed(&mut adapter, 100.0, 102.0);
+    // Ahead by 50 s, and then back by 100 s: each run of agreeing samples is one jump.
+    feed(&mut adapter, 152.0, 153.0);
+    assert_eq!(
+        adapter.engine().counters().count(RejectionReason::ImuGap),
+        1
+    );
+    assert_eq!(adapter.engine().last_imu_t_s(), Some(152.99));
+    feed(
+        &mut adapter,
+        52.0,
+        52.0 + 0.01 * TIME_JUMP_CONFIRM_SAMPLES as f64,
+    );
+    assert_eq!(adapter.counts().time_jump_resets, 1);
+    assert_eq!(adapter.counts().imu_stamp_outliers, 0);
+    assert_eq!(
+        adapter.engine().last_imu_t_s(),
+        Some(52.0 + 0.01 * (TIME_JUMP_CONFIRM_SAMPLES - 1) as f64),
+        "the held samples were fed"
+    );
+    // One sample short of a run: outliers.
+    feed(
+        &mut adapter,
+        10.0,
+        10.0 + 0.01 * (TIME_JUMP_CONFIRM_SAMPLES - 1) as f64,
+    );
+    feed(&mut adapter, 52.1, 52.2);
+    assert_eq!(adapter.counts().time_jump_resets, 1);
+    assert_eq!(
+        adapter.counts().imu_stamp_outliers,
+        TIME_JUMP_CONFIRM_SAMPLES as u64 - 1
+    );
+}
+
+#[test]
+fn a_flood_of_imu_samples_and_far_future_measurements_keep_the_buffers_bounded() {
+    use crate::engine::{MAX_BUFFERED_IMU_SAMPLES, MAX_PENDING_MEASUREMENTS};
+    use crate::sim::SimEvent;
+    // Issue 12, item 12: stamps 1 µs apart, and a fix 1000 s ahead, grew memory for good.
+    let mut adapter = loose_adapter(OutputFrames::default());
+    let mut last = None;
+    let mut fix = None;
+    for_each_static_event_30_s(|event, stamp| match event {
+        SimEvent::Imu(s) => {
+            adapter.on_imu(&outbound::imu(&s, stamp, "imu"));
+            last = Some(s);
+        }
+        SimEvent::Fix(f) => {
+            adapter.on_fix(&outbound::receiver_fix(&f, stamp, "gnss"));
+            fix = Some(f);
+        }
+        _ => {}
+    });
+    assert_eq!(adapter.engine().init_phase(), None, "running");
+    let (last, mut fix) = (last.unwrap(), fix.unwrap());
+    let t0_s = last.t_s;
+    let mut most = adapter.engine().buffered();
+    for k in 1..=100_000u32 {
+        let t_s = t0_s + 1e-6 * f64::from(k);
+        adapter.on_imu(&imu_message(&last, t_s, "imu"));
+        if k % 1000 == 0 {
+            // A fix stamped 1000 s ahead: rejected, never queued.
+            fix.t_s = t_s + 1000.0;
+            let stamp = seconds_to_time(fix.t_s).unwrap();
+            adapter.on_fix(&outbound::receiver_fix(&fix, stamp, "gnss"));
+            let b = adapter.engine().buffered();
+            most.imu_samples = most.imu_samples.max(b.imu_samples);
+            most.states = most.states.max(b.states);
+            most.measurements = most.measurements.max(b.measurements);
+        }
+    }
+    assert_eq!(
+        adapter.engine().last_imu_t_s(),
+        Some(t0_s + 1e-6 * 100_000.0)
+    );
+    assert_eq!(adapter.engine().init_phase(), None, "still running");
+    assert_eq!(most.imu_samples, MAX_BUFFERED_IMU_SAMPLES);
+    assert_eq!(most.states, MAX_BUFFERED_IMU_SAMPLES);
+    assert!(most.measurements <= 1, "{most:?}");
+    let counters = adapter.engine().counters();
+    assert_eq!(counters.count(RejectionReason::MeasurementTooNew), 100);
+    assert_eq!(
+        diagnostic(&adapter, "rejected_measurement_too_new").as_deref(),
+        Some("100")
+    );
+    // Without any IMU, measurements wait; the queue keeps the newest.
+    let mut adapter = loose_adapter(OutputFrames::default());
+    for k in 0..3 * MAX_PENDING_MEASUREMENTS {
+        fix.t_s = 10.0 + k as f64;
+        let stamp = seconds_to_time(fix.t_s).unwrap();
+        adapter.on_fix(&outbound::receiver_fix(&fix, stamp, "gnss"));
+    }
+    assert_eq!(
+        adapter.engine().buffered().measurements,
+        MAX_PENDING_MEASUREMENTS
+    );
+    assert_eq!(
+        adapter
+            .engine()
+            .counters()
+            .count(RejectionReason::MeasurementQueueFull),
+        2 * MAX_PENDING_MEASUREMENTS as u64
+    );
 }

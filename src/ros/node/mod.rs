@@ -132,8 +132,12 @@ pub fn run(
     let fqn = node.fully_qualified_name();
     let logger = rosout::logger_name(&fqn);
     let mut core = RosAdapter::new(config, params.frames.clone());
+    if let Some(imu_frame) = &params.imu_frame {
+        core = core.with_imu_frame(imu_frame);
+    }
     let mut parameters = ParameterServer::new(params.use_sim_time, params.frames)
-        .with_queue_depth(params.queue_depth);
+        .with_queue_depth(params.queue_depth)
+        .with_imu_frame(params.imu_frame);
     let mut clock = NodeClock::default();
     let mut stats = InputStats::default();
 

@@ -4,7 +4,7 @@
 //!
 //! The parameters are the core configuration's (`section.key`, human units, the names of
 //! the parameter file) plus the node's own `use_sim_time`, `map_frame`, `base_frame`,
-//! `publish_tf` and `queue_depth`; their descriptions, ranges and read-only flags come
+//! `publish_tf`, `queue_depth` and `imu_frame`; their descriptions, ranges and read-only flags come
 //! from the parameter table and `NODE_PARAMETERS`. A set request is validated like the
 //! parameter file; only the run-time parameters (and `use_sim_time`) are accepted while
 //! the node runs, every other parameter is read-only and a set is refused with the reason.
@@ -30,7 +30,7 @@ use crate::config::{self, Config, ConfigError, Kind};
 use crate::ros::cdr;
 
 use super::params::{
-    NodeParameter, OutputFrames, BASE_FRAME, DEFAULT_QUEUE_DEPTH, MAP_FRAME, PUBLISH_TF,
+    NodeParameter, OutputFrames, BASE_FRAME, DEFAULT_QUEUE_DEPTH, IMU_FRAME, MAP_FRAME, PUBLISH_TF,
     QUEUE_DEPTH, USE_SIM_TIME,
 };
 use crate::ros::adapter::RosAdapter;
@@ -68,6 +68,7 @@ pub struct ParameterServer {
     use_sim_time: bool,
     frames: OutputFrames,
     queue_depth: usize,
+    imu_frame: Option<String>,
     log: LogLimiter,
 }
 
@@ -248,6 +249,7 @@ impl ParameterServer {
             use_sim_time,
             frames,
             queue_depth: DEFAULT_QUEUE_DEPTH,
+            imu_frame: None,
             log: LogLimiter::default(),
         }
     }
@@ -255,6 +257,12 @@ impl ParameterServer {
     /// The server reporting `depth` as the node's `queue_depth`.
     pub fn with_queue_depth(mut self, depth: usize) -> Self {
         self.queue_depth = depth;
+        self
+    }
+
+    /// The server reporting `frame_id` as the node's `imu_frame` (None: empty).
+    pub fn with_imu_frame(mut self, frame_id: Option<String>) -> Self {
+        self.imu_frame = frame_id;
         self
     }
 
@@ -273,6 +281,10 @@ impl ParameterServer {
             (BASE_FRAME, Value::String(f.base_frame.clone())),
             (PUBLISH_TF, Value::Bool(f.publish_tf)),
             (QUEUE_DEPTH, Value::Number(self.queue_depth.into())),
+            (
+                IMU_FRAME,
+                Value::String(self.imu_frame.clone().unwrap_or_default()),
+            ),
         ];
         node.into_iter()
             .map(|(name, v)| (name.to_owned(), parameter_value(&v)))
@@ -425,6 +437,12 @@ impl ParameterServer {
             return Err(format!(
                 "`{name}` is read-only while the node runs (the DDS entities are created \
                  with it): restart the node with -p {name}:=VALUE or a parameter file"
+            ));
+        }
+        if name == IMU_FRAME {
+            return Err(format!(
+                "`{name}` is read-only while the node runs (the filter follows one IMU): \
+                 restart the node with -p {name}:=VALUE or a parameter file"
             ));
         }
         if [MAP_FRAME, BASE_FRAME, PUBLISH_TF].contains(&name.as_str()) {
@@ -643,7 +661,8 @@ mod tests {
                 "map_frame",
                 "base_frame",
                 "publish_tf",
-                "queue_depth"
+                "queue_depth",
+                "imu_frame"
             ],
             "no separator"
         );

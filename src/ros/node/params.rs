@@ -60,6 +60,8 @@ pub const BASE_FRAME: &str = "base_frame";
 pub const PUBLISH_TF: &str = "publish_tf";
 /// Depth (messages) of the input subscriptions' and the publishers' history.
 pub const QUEUE_DEPTH: &str = "queue_depth";
+/// The `header.frame_id` of the IMU; empty: learnt from the stream.
+pub const IMU_FRAME: &str = "imu_frame";
 
 /// Default of [`QUEUE_DEPTH`].
 ///
@@ -109,7 +111,7 @@ pub const QUEUE_DEPTH_PARAMETER: NodeParameter = NodeParameter {
 /// Choice: the frames, the TF switch and the queue depth are fixed at start (read-only
 /// through the parameter services): a TF tree whose frames change while it runs would
 /// break its listeners, and the DDS entities are created with the depth.
-pub const NODE_PARAMETERS: [NodeParameter; 5] = [
+pub const NODE_PARAMETERS: [NodeParameter; 6] = [
     USE_SIM_TIME_PARAMETER,
     NodeParameter {
         name: MAP_FRAME,
@@ -136,6 +138,16 @@ pub const NODE_PARAMETERS: [NodeParameter; 5] = [
         doc: "Publish map_frame -> base_frame on /tf with each odometry.",
     },
     QUEUE_DEPTH_PARAMETER,
+    NodeParameter {
+        name: IMU_FRAME,
+        kind: Kind::Text,
+        default: "''",
+        range: "empty, or a frame id (no spaces)",
+        runtime: false,
+        doc: "The IMU's header.frame_id: samples from any other frame are dropped and \
+              counted. Empty: the first frame is followed, and another one that keeps \
+              arriving once it went silent (a stray publisher cannot lock out the IMU).",
+    },
 ];
 
 impl NodeParameter {
@@ -190,6 +202,8 @@ pub struct NodeParams {
     pub frames: OutputFrames,
     /// History depth of the subscriptions and publishers.
     pub queue_depth: usize,
+    /// The IMU's frame when configured (else learnt from the stream).
+    pub imu_frame: Option<String>,
 }
 
 /// The node's parameters from the values resolved for it.
@@ -220,6 +234,7 @@ pub fn node_params_from(values: &[Assignment]) -> Result<NodeParams, ParamsError
         use_sim_time: boolean(value(USE_SIM_TIME), USE_SIM_TIME, false)?,
         frames,
         queue_depth: depth(value(QUEUE_DEPTH))?,
+        imu_frame: optional_frame(value(IMU_FRAME), IMU_FRAME)?,
     })
 }
 
@@ -263,6 +278,21 @@ pub(crate) fn frame(
             name,
             "must be a frame id (a non-empty string without spaces)",
         )),
+    }
+}
+
+/// A frame id or, empty or unset, none.
+fn optional_frame(
+    a: Option<&Assignment>,
+    name: &'static str,
+) -> Result<Option<String>, ParamsError> {
+    match a {
+        Some(Assignment {
+            value: Value::String(s),
+            ..
+        }) if s.is_empty() => Ok(None),
+        Some(_) => frame(a, name, "").map(Some),
+        None => Ok(None),
     }
 }
 
@@ -518,6 +548,7 @@ mod tests {
             (BASE_FRAME, p.frames.base_frame.into()),
             (PUBLISH_TF, Value::Bool(p.frames.publish_tf)),
             (QUEUE_DEPTH, Value::from(p.queue_depth)),
+            (IMU_FRAME, p.imu_frame.unwrap_or_default().into()),
         ];
         for (name, value) in loaded {
             let declared = NodeParameter::named(name).unwrap().default;
@@ -538,6 +569,23 @@ mod tests {
         for bad in ["0", "-3", "2.5", "deep", "60001"] {
             let set = format!("queue_depth:={bad}");
             assert!(load_with(&[], &["-p", &set]).is_err(), "{bad} accepted");
+        }
+    }
+
+    #[test]
+    fn imu_frame_is_the_nodes_and_optional() {
+        assert_eq!(load_with(&[FILE], &[]).unwrap().imu_frame, None);
+        let p = load_with(&[FILE], &["-p", "imu_frame:=imu_link"]).unwrap();
+        assert_eq!(p.imu_frame.as_deref(), Some("imu_link"));
+        assert_eq!(variant(&p), "ermakf");
+        let p = load_with(&[FILE], &["-p", "imu_frame:=''"]).unwrap();
+        assert_eq!(p.imu_frame, None, "empty: learnt");
+        for bad in ["imu_frame:=12", "imu_frame:='a b'"] {
+            let e = load_with(&[FILE], &["-p", bad]);
+            assert!(
+                matches!(e, Err(ParamsError::NodeParameter { .. })),
+                "{bad}: {e:?}"
+            );
         }
     }
 
