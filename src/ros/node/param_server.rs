@@ -56,10 +56,11 @@ pub const MAX_NAMES: usize = 256;
 pub const MAX_VALUE_LEN: usize = 1024;
 /// Largest reply payload (bytes of CDR).
 ///
-/// Choice: 32 KiB. A reply larger than a UDP datagram (about 64 KB) never reaches a
-/// Cyclone DDS client (issue 12), and the describe reply of every parameter takes about
-/// half of this budget.
-pub const MAX_REPLY_BYTES: usize = 32 * 1024;
+/// Choice: 48 KiB. A reply larger than a UDP datagram (about 64 KB) never reaches a
+/// Cyclone DDS client (issue 12), so 16 KiB are left for the RTPS headers; the describe
+/// reply of every parameter takes about half of this budget (25 KB with the IMU screen's
+/// and the IMU frame's parameters; it outgrew 32 KiB's three quarters).
+pub const MAX_REPLY_BYTES: usize = 48 * 1024;
 
 /// The parameter services' state: the node-level parameters and the rate limit of the
 /// refusals' log lines.
