@@ -33,7 +33,7 @@ use crate::ros::msg::{
 use clock::NodeClock;
 pub use dds::{domain_id_from, DdsOptions, NodeError, DIAGNOSTICS_PERIOD};
 use dds::{events, subscription, Names, Output};
-use input_stats::{InputStats, Stream};
+use input_stats::{InputStats, Stream, FILTER_NODE_STREAMS};
 use param_server::ParameterServer;
 use params::NodeParams;
 use recorder::Recorder;
@@ -139,7 +139,7 @@ pub fn run(
         .with_queue_depth(params.queue_depth)
         .with_imu_frame(params.imu_frame);
     let mut clock = NodeClock::default();
-    let mut stats = InputStats::default();
+    let mut stats = InputStats::new(FILTER_NODE_STREAMS);
 
     let mut sources: Vec<LocalBoxStream<'_, Event>> = vec![
         events(&imu_sub, Event::Imu),
@@ -175,28 +175,28 @@ pub fn run(
             let now_s = || clock.now_s(parameters.use_sim_time());
             let msgs = match event {
                 Event::Imu(m) => {
-                    stats.record(Stream::Imu, now_s());
+                    stats.record(Stream::Imu.index(), now_s());
                     match m {
                         Ok(m) => core.on_imu(&m),
                         Err(e) => undecodable(&mut core, "imu", &e),
                     }
                 }
                 Event::Gnss(m) => {
-                    stats.record(Stream::Gnss, now_s());
+                    stats.record(Stream::Gnss.index(), now_s());
                     match m {
                         Ok(m) => core.on_gnss(&m),
                         Err(e) => undecodable(&mut core, "gnss/measurements", &e),
                     }
                 }
                 Event::Fix(m) => {
-                    stats.record(Stream::Fix, now_s());
+                    stats.record(Stream::Fix.index(), now_s());
                     match m {
                         Ok(m) => core.on_fix(&m),
                         Err(e) => undecodable(&mut core, "gnss/fix", &e),
                     }
                 }
                 Event::Velocity(m) => {
-                    stats.record(Stream::Velocity, now_s());
+                    stats.record(Stream::Velocity.index(), now_s());
                     match m {
                         Ok(m) => core.on_velocity(&m),
                         Err(e) => undecodable(&mut core, "gnss/velocity", &e),

@@ -23,6 +23,7 @@ use crate::ros::msg::{
 use crate::ros::node::clock::NodeClock;
 use crate::ros::node::dds::{self, events, subscription, DdsOptions, Names, NodeError, Output};
 use crate::ros::node::housekeeping;
+use crate::ros::node::input_stats::{InputStats, StreamSet};
 use crate::ros::node::rosout::{self, LogLine, LogLines};
 use crate::ros::node::services::{ParamRequest, ParameterServices};
 use crate::ros::ubx_adapter::UbxAdapter;
@@ -70,6 +71,30 @@ enum Event {
     Shutdown,
 }
 
+impl Event {
+    /// The index in [`UBX_NODE_STREAMS`] of an input message (decodable or not).
+    fn stream(&self) -> Option<usize> {
+        match self {
+            Self::Rawx(_) => Some(0),
+            Self::Sfrbx(_) => Some(1),
+            Self::Stream(_) => Some(2),
+            Self::Imu(_) => Some(3),
+            _ => None,
+        }
+    }
+}
+
+/// Choice: a receiver outputs RAWX at 1–20 Hz; three silent seconds (three missed epochs
+/// at 1 Hz) while it was heard before means it stopped, and /diagnostics says so.
+const RECEIVER_STALE_S: f64 = 3.0;
+
+/// The node's input streams on /diagnostics; the receiver's (RAWX, or the UBX byte stream
+/// of ublox_gps) are watched.
+const UBX_NODE_STREAMS: StreamSet = StreamSet {
+    keys: &["rawx", "sfrbx", "ubx_stream", "imu"],
+    watched: &[(0, RECEIVER_STALE_S), (2, RECEIVER_STALE_S)],
+};
+
 /// Runs the node until the process is stopped (or the DDS streams end). `log_lines`
 /// (from [`rosout::init_logging`]) are published on `/rosout`.
 pub fn run(
@@ -101,6 +126,7 @@ pub fn run(
     let mut parameters = UbxParameterServer::new(params);
     let mut clock = NodeClock::default();
     let mut log = LogLimiter::default();
+    let mut stats = InputStats::new(UBX_NODE_STREAMS);
 
     let mut sources: Vec<LocalBoxStream<'_, Event>> = vec![
         events(&rawx_sub, Event::Rawx),
@@ -126,6 +152,9 @@ pub fn run(
         while let Some(event) = events.next().await {
             let use_sim_time = parameters.use_sim_time();
             let arrival_s = clock.now_s(use_sim_time);
+            if let Some(stream) = event.stream() {
+                stats.record(stream, arrival_s);
+            }
             let out: Vec<GnssMeasurements> = match event {
                 Event::Rawx(Ok(m)) => adapter.on_rawx(&m, arrival_s).into_iter().collect(),
                 Event::Sfrbx(Ok(m)) => {
@@ -164,7 +193,11 @@ pub fn run(
                             stamp,
                             frame_id: String::new(),
                         },
-                        status: vec![adapter.diagnostics(&fqn)],
+                        status: vec![{
+                            let mut status = adapter.diagnostics(&fqn);
+                            stats.report(&mut status, arrival_s);
+                            status
+                        }],
                     };
                     if let Err(e) = diagnostics.send(report, &mut recorder, stamp) {
                         log::warn!("publishing diagnostics failed: {e}");
