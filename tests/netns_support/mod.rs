@@ -23,7 +23,14 @@ pub fn reexec_in_private_netns(name: &str) -> bool {
     let status = Command::new("unshare")
         .args(["-n", "sh", "-c", "ip link set lo up && exec \"$0\" \"$@\""])
         .arg(exe)
-        .args([name, "--exact", "--nocapture", "--test-threads=1"])
+        // --include-ignored: an ignored test run by hand is run inside too.
+        .args([
+            name,
+            "--exact",
+            "--include-ignored",
+            "--nocapture",
+            "--test-threads=1",
+        ])
         .env(IN_NETNS, "1")
         .status()
         .unwrap();
