@@ -48,6 +48,7 @@ impl RosAdapter {
             Ok(s) => s,
             Err(e) => return self.unconvertible(Input::Imu, &e.to_string()),
         };
+        self.imu_stamps.note(sample.t_s, msg.header.stamp);
         let frame_id = &msg.header.frame_id;
         let mut outputs = Vec::new();
         match self.imu_frame.admit(frame_id) {
@@ -114,6 +115,7 @@ impl RosAdapter {
             Ok(e) => e,
             Err(e) => return self.unconvertible(Input::Gnss, &e.to_string()),
         };
+        self.measurement_stamps.note(epoch.t_s, msg.header.stamp);
         match self.gnss_frame.admit(&msg.header.frame_id) {
             Admission::Admitted => {}
             Admission::Foreign => return self.foreign_frame(Input::Gnss, &msg.header.frame_id),
@@ -140,6 +142,7 @@ impl RosAdapter {
             Ok(f) => f,
             Err(e) => return self.unconvertible(Input::Fix, &e.to_string()),
         };
+        self.measurement_stamps.note(fix.t_s, msg.header.stamp);
         match self.fix_frame.admit(&msg.header.frame_id) {
             Admission::Admitted => {}
             Admission::Foreign => return self.foreign_frame(Input::Fix, &msg.header.frame_id),

@@ -30,6 +30,7 @@ mod frame_lock;
 mod guard;
 mod inputs;
 mod outputs;
+mod stamp_book;
 #[cfg(test)]
 mod tests;
 mod time_line;
@@ -43,6 +44,7 @@ pub use counts::{Input, InputCounts};
 use frame_lock::FrameLock;
 pub use inputs::InputMessage;
 pub use outputs::{OutputFrames, Published, PublishedEpoch, PublishedSolution, SolutionMessages};
+use stamp_book::StampBook;
 use time_line::TimeLine;
 pub use time_line::{TIME_JUMP_BACK_S, TIME_JUMP_CONFIRM_SAMPLES};
 
@@ -57,6 +59,10 @@ pub struct RosAdapter {
     fix_frame: FrameLock,
     pairing: FixVelocityJoin,
     outputs: outputs::Framing,
+    /// The stamps of the IMU samples, which solutions carry.
+    imu_stamps: StampBook,
+    /// The stamps of the GNSS epochs and fixes, which their reports carry.
+    measurement_stamps: StampBook,
 }
 
 impl RosAdapter {
@@ -72,6 +78,8 @@ impl RosAdapter {
             time_line: TimeLine::default(),
             gnss_frame: FrameLock::default(),
             fix_frame: FrameLock::default(),
+            imu_stamps: StampBook::default(),
+            measurement_stamps: StampBook::default(),
         }
     }
 

@@ -3,11 +3,11 @@
 
 use crate::earth::Llh;
 use crate::engine::{EpochReport, Output, Solution, StatusEvent};
-use crate::ros::convert::seconds_to_time;
 use crate::ros::msg::{NavSatFix, NoiseEstimates, Odometry, TFMessage};
 use crate::ros::outbound;
 
 use super::guard::{self, Unpublishable};
+use super::stamp_book::StampBook;
 use super::RosAdapter;
 
 /// The frames of the published messages and whether the TF is published.
@@ -110,18 +110,30 @@ impl Framing {
     /// again for an overflow or for a negative variance of the twist's rotated velocity
     /// covariance (a velocity block that is no covariance any more: a diverged filter;
     /// 10 of 1979 dropped solutions in the replay test of issue 12, item 7).
-    fn solution(&mut self, solution: Box<Solution>) -> Result<PublishedSolution, Unpublishable> {
+    ///
+    /// The messages carry the stamp `imu_stamps` holds for the solution's time.
+    fn solution(
+        &mut self,
+        solution: Box<Solution>,
+        imu_stamps: &StampBook,
+    ) -> Result<PublishedSolution, Unpublishable> {
         guard::judge(&solution)?;
         let messages = if self.messages {
-            Some(Box::new(self.messages_of(&solution)?))
+            Some(Box::new(self.messages_of(&solution, imu_stamps)?))
         } else {
             None
         };
         Ok(PublishedSolution { solution, messages })
     }
 
-    fn messages_of(&mut self, solution: &Solution) -> Result<SolutionMessages, Unpublishable> {
-        let stamp = seconds_to_time(solution.nav.t_s).map_err(|_| Unpublishable::NonFinite)?;
+    fn messages_of(
+        &mut self,
+        solution: &Solution,
+        imu_stamps: &StampBook,
+    ) -> Result<SolutionMessages, Unpublishable> {
+        let stamp = imu_stamps
+            .stamp(solution.nav.t_s)
+            .map_err(|_| Unpublishable::NonFinite)?;
         let datum = *self.datum.get_or_insert(solution.nav.p);
         let f = &self.frames;
         let odometry = outbound::odometry(solution, &datum, stamp, &f.map_frame, &f.base_frame);
@@ -142,25 +154,27 @@ impl RosAdapter {
         let mut published = Vec::with_capacity(outputs.len());
         for output in outputs {
             match output {
-                Output::Solution(solution) => match self.outputs.solution(solution) {
-                    Ok(s) => published.push(Published::Solution(s)),
-                    Err(Unpublishable::NonFinite) => {
-                        self.counts.non_finite_outputs += 1;
-                        self.log.warn(
-                            "non_finite_output",
-                            "solution with a non-finite value dropped",
-                        );
+                Output::Solution(solution) => {
+                    match self.outputs.solution(solution, &self.imu_stamps) {
+                        Ok(s) => published.push(Published::Solution(s)),
+                        Err(Unpublishable::NonFinite) => {
+                            self.counts.non_finite_outputs += 1;
+                            self.log.warn(
+                                "non_finite_output",
+                                "solution with a non-finite value dropped",
+                            );
+                        }
+                        Err(Unpublishable::NegativeVariance) => {
+                            self.counts.negative_variance_outputs += 1;
+                            self.log.warn(
+                                "negative_variance_output",
+                                "solution with a negative variance dropped",
+                            );
+                        }
                     }
-                    Err(Unpublishable::NegativeVariance) => {
-                        self.counts.negative_variance_outputs += 1;
-                        self.log.warn(
-                            "negative_variance_output",
-                            "solution with a negative variance dropped",
-                        );
-                    }
-                },
+                }
                 Output::Epoch(report) => {
-                    if let Ok(stamp) = seconds_to_time(report.t_s) {
+                    if let Ok(stamp) = self.measurement_stamps.stamp(report.t_s) {
                         let noise = outbound::noise_estimates(
                             &report,
                             stamp,

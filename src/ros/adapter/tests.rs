@@ -584,3 +584,65 @@ fn a_flood_of_imu_samples_and_far_future_measurements_keep_the_buffers_bounded()
         2 * MAX_PENDING_MEASUREMENTS as u64
     );
 }
+
+/// `stamp` moved `sec` seconds and `nanosec` nanoseconds later (`nanosec` below what
+/// keeps the nanoseconds of the simulator's stamps, multiples of 10 ms, under a second).
+fn later(stamp: Time, sec: i32, nanosec: u32) -> Time {
+    Time {
+        sec: stamp.sec + sec,
+        nanosec: stamp.nanosec + nanosec,
+    }
+}
+
+#[test]
+fn outputs_carry_their_inputs_stamps_to_the_nanosecond() {
+    use crate::sim::SimEvent;
+    use std::collections::HashSet;
+    // Stamps of this decade, where f64 seconds resolve 238 ns: IMU samples at x.0025 s,
+    // every other one a nanosecond later, fixes at x.000000001 s.
+    const SEC_2025: i32 = 1_764_000_000;
+    let frames = OutputFrames {
+        publish_tf: true,
+        ..OutputFrames::default()
+    };
+    let mut adapter = loose_adapter(frames);
+    let (mut imu_stamps, mut fix_stamps) = (HashSet::new(), HashSet::new());
+    let mut out = Vec::new();
+    let mut k = 0;
+    for_each_static_event_30_s(|event, stamp| match event {
+        SimEvent::Imu(s) => {
+            k += 1;
+            let stamp = later(stamp, SEC_2025, 2_500_000 + k % 2);
+            imu_stamps.insert(stamp);
+            out.extend(adapter.on_imu(&outbound::imu(&s, stamp, "imu")));
+        }
+        SimEvent::Fix(f) => {
+            let stamp = later(stamp, SEC_2025, 1);
+            fix_stamps.insert(stamp);
+            out.extend(adapter.on_fix(&outbound::receiver_fix(&f, stamp, "gnss")));
+        }
+        _ => {}
+    });
+    let (mut solutions, mut reports) = (0, 0);
+    for published in &out {
+        match published {
+            Published::Solution(s) => {
+                let m = s.messages.as_deref().unwrap();
+                let stamp = m.odometry.header.stamp;
+                assert!(imu_stamps.contains(&stamp), "Odometry at {stamp:?}");
+                assert_eq!(m.fix.header.stamp, stamp);
+                assert_eq!(m.tf.as_ref().unwrap().transforms[0].header.stamp, stamp);
+                solutions += 1;
+            }
+            Published::Epoch(e) => {
+                let stamp = e.noise.header.stamp;
+                assert!(fix_stamps.contains(&stamp), "NoiseEstimates at {stamp:?}");
+                reports += 1;
+            }
+        }
+    }
+    assert!(
+        solutions > 2000 && reports > 25,
+        "{solutions} solutions, {reports} reports"
+    );
+}
