@@ -2,18 +2,21 @@
 //! golden fixture restamped into this decade, where `f64` seconds resolve only 238 ns,
 //! with IMU stamps at x.0025 s (every other one a nanosecond later) and GNSS epochs at
 //! x.000000001 s, gives Odometry, NavSatFix and /tf at exactly an IMU stamp and
-//! NoiseEstimates at exactly an epoch's.
+//! NoiseEstimates at exactly an epoch's; each NavSatFix names only constellations an
+//! update used (issue 16, item 4).
 
 use std::collections::HashSet;
 use std::path::Path;
 
 use adaptive_gnss_ins::config::Config;
+use adaptive_gnss_ins::gnss::Constellation;
 use adaptive_gnss_ins::ros::adapter::OutputFrames;
 use adaptive_gnss_ins::ros::bag::{BagReader, BagWriter};
 use adaptive_gnss_ins::ros::cdr;
 use adaptive_gnss_ins::ros::msg::{
     GnssMeasurements, Imu, NavSatFix, NoiseEstimates, Odometry, TFMessage, Time,
 };
+use adaptive_gnss_ins::ros::outbound::service_of;
 use adaptive_gnss_ins::tools::replay::{replay, ReplayOptions, TruthSource};
 
 const NS_PER_S: u64 = 1_000_000_000;
@@ -90,6 +93,8 @@ fn replay_outputs_carry_their_inputs_stamps_to_the_nanosecond() {
     )
     .unwrap();
     let mut counts = std::collections::HashMap::<String, usize>::new();
+    // The NavSatFix service bits, and those of every constellation an update used.
+    let (mut services, mut used_service) = (HashSet::new(), 0);
     for m in BagReader::open(&out).unwrap().messages().unwrap() {
         let m = m.unwrap();
         let (stamp, at) = match m.topic.as_str() {
@@ -97,16 +102,20 @@ fn replay_outputs_carry_their_inputs_stamps_to_the_nanosecond() {
                 cdr::decode::<Odometry>(&m.data).unwrap().header.stamp,
                 &imu_stamps,
             ),
-            "/fix" => (
-                cdr::decode::<NavSatFix>(&m.data).unwrap().header.stamp,
-                &imu_stamps,
-            ),
+            "/fix" => {
+                let fix: NavSatFix = cdr::decode(&m.data).unwrap();
+                services.insert(fix.status.service);
+                (fix.header.stamp, &imu_stamps)
+            }
             "/tf" => {
                 let tf: TFMessage = cdr::decode(&m.data).unwrap();
                 (tf.transforms[0].header.stamp, &imu_stamps)
             }
             "/noise_estimates" => {
                 let noise: NoiseEstimates = cdr::decode(&m.data).unwrap();
+                let used = noise.satellites.iter().filter(|s| s.used);
+                used_service |=
+                    service_of(used.map(|s| Constellation::from_code(s.constellation).unwrap()));
                 (noise.header.stamp, &epoch_stamps)
             }
             other => panic!("unexpected topic {other}"),
@@ -119,4 +128,10 @@ fn replay_outputs_carry_their_inputs_stamps_to_the_nanosecond() {
     assert_eq!(count("/fix"), count("/odometry"));
     assert_eq!(count("/tf"), count("/odometry"));
     assert!(count("/noise_estimates") > 20, "{counts:?}");
+    // Every fix names only constellations the filter used (issue 16, item 4); those
+    // before the first update that used one say SERVICE_UNKNOWN (0).
+    assert!(
+        services.contains(&used_service) && services.iter().all(|&s| s & !used_service == 0),
+        "{services:?} against {used_service}"
+    );
 }

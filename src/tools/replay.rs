@@ -197,6 +197,9 @@ impl ReplayOutputs {
                     let noise = &epoch.noise;
                     w.write(NOISE_TOPIC, noise, log_time_ns(&noise.header.stamp))?;
                 }
+                Published::NoFix(fix) => {
+                    w.write(FIX_OUT_TOPIC, fix.as_ref(), log_time_ns(&fix.header.stamp))?;
+                }
             }
         }
         if let (Some((w, path)), Published::Solution(s)) = (self.csv.as_mut(), published) {

@@ -148,6 +148,7 @@ impl RosAdapter {
             Admission::Foreign => return self.foreign_frame(Input::Fix, &msg.header.frame_id),
             Admission::Switched => self.frame_switched(Input::Fix, &msg.header.frame_id),
         }
+        self.outputs.fix_received(msg.status.service);
         let released = self.pairing.on_fix(FramedFix {
             fix,
             frame_id: msg.header.frame_id.clone(),

@@ -2,8 +2,8 @@
 //! TF, behind the guard ([`super::guard`]); status events are logged.
 
 use crate::earth::Llh;
-use crate::engine::{EpochReport, Output, Solution, StatusEvent};
-use crate::ros::msg::{NavSatFix, NoiseEstimates, Odometry, TFMessage};
+use crate::engine::{EpochReport, MeasurementKind, Output, Solution, StatusEvent};
+use crate::ros::msg::{NavSatFix, NavSatStatus, NoiseEstimates, Odometry, TFMessage};
 use crate::ros::outbound;
 
 use super::guard::{self, Unpublishable};
@@ -43,6 +43,9 @@ pub enum Published {
     Solution(PublishedSolution),
     /// An epoch's report, on `~/noise_estimates`.
     Epoch(Box<PublishedEpoch>),
+    /// A solution the guard refused, on `fix` as `STATUS_NO_FIX` at its stamp: the filter
+    /// cannot tell its position then (see [`outbound::no_fix`]).
+    NoFix(Box<NavSatFix>),
 }
 
 /// An epoch's report and its message.
@@ -83,6 +86,10 @@ pub(super) struct Framing {
     datum: Option<Llh>,
     /// Whether solutions are framed into messages.
     messages: bool,
+    /// NavSatFix service bits of the last update that used a measurement.
+    service: u16,
+    /// NavSatFix service bits of the last receiver fix received (loose coupling).
+    fix_service: u16,
 }
 
 impl Framing {
@@ -91,7 +98,45 @@ impl Framing {
             frames,
             datum,
             messages: true,
+            service: NavSatStatus::SERVICE_UNKNOWN,
+            fix_service: NavSatStatus::SERVICE_UNKNOWN,
         }
+    }
+
+    /// Remembers the service bits of a receiver fix, which its update will have used.
+    pub(super) fn fix_received(&mut self, service: u16) {
+        self.fix_service = service;
+    }
+
+    /// Takes the constellations `report` used as the solutions' service from now on.
+    ///
+    /// Choice: an update that used nothing keeps the last service (the solutions coast on
+    /// the IMU, their covariance grows); a loosely-coupled update used the receiver's
+    /// fix, which names its own service.
+    fn used(&mut self, report: &EpochReport) {
+        if report.measurements_used == 0 {
+            return;
+        }
+        let service = match report.kind {
+            MeasurementKind::Pseudoranges => outbound::service_of(
+                report
+                    .satellites
+                    .iter()
+                    .filter(|s| s.used_pseudorange || s.used_rate)
+                    .map(|s| s.sat.constellation),
+            ),
+            MeasurementKind::Fix => self.fix_service,
+        };
+        if service != NavSatStatus::SERVICE_UNKNOWN {
+            self.service = service;
+        }
+    }
+
+    /// The NO_FIX NavSatFix of a solution at `t_s` the guard refused; None from an adapter
+    /// that frames no messages or for a time without a stamp.
+    fn no_fix(&self, t_s: f64, imu_stamps: &StampBook) -> Option<Box<NavSatFix>> {
+        let stamp = imu_stamps.stamp(t_s).ok().filter(|_| self.messages)?;
+        Some(Box::new(outbound::no_fix(stamp, &self.frames.base_frame)))
     }
 
     pub(super) fn frames(&self) -> &OutputFrames {
@@ -137,7 +182,7 @@ impl Framing {
         let datum = *self.datum.get_or_insert(solution.nav.p);
         let f = &self.frames;
         let odometry = outbound::odometry(solution, &datum, stamp, &f.map_frame, &f.base_frame);
-        let fix = outbound::nav_sat_fix(solution, stamp, &f.base_frame);
+        let fix = outbound::nav_sat_fix(solution, stamp, &f.base_frame, self.service);
         guard::judge_messages(&odometry, &fix)?;
         Ok(SolutionMessages {
             tf: f.publish_tf.then(|| outbound::transform(&odometry)),
@@ -155,16 +200,25 @@ impl RosAdapter {
         for output in outputs {
             match output {
                 Output::Solution(solution) => {
-                    match self.outputs.solution(solution, &self.imu_stamps) {
-                        Ok(s) => published.push(Published::Solution(s)),
-                        Err(Unpublishable::NonFinite) => {
+                    let t_s = solution.nav.t_s;
+                    let refused = match self.outputs.solution(solution, &self.imu_stamps) {
+                        Ok(s) => {
+                            published.push(Published::Solution(s));
+                            continue;
+                        }
+                        Err(refused) => refused,
+                    };
+                    let no_fix = self.outputs.no_fix(t_s, &self.imu_stamps);
+                    published.extend(no_fix.map(Published::NoFix));
+                    match refused {
+                        Unpublishable::NonFinite => {
                             self.counts.non_finite_outputs += 1;
                             self.log.warn(
                                 "non_finite_output",
                                 "solution with a non-finite value dropped",
                             );
                         }
-                        Err(Unpublishable::NegativeVariance) => {
+                        Unpublishable::NegativeVariance => {
                             self.counts.negative_variance_outputs += 1;
                             self.log.warn(
                                 "negative_variance_output",
@@ -174,6 +228,7 @@ impl RosAdapter {
                     }
                 }
                 Output::Epoch(report) => {
+                    self.outputs.used(&report);
                     if let Ok(stamp) = self.measurement_stamps.stamp(report.t_s) {
                         let noise = outbound::noise_estimates(
                             &report,

@@ -83,6 +83,9 @@ impl Outputs {
                 Published::Epoch(epoch) => {
                     log_failure(log, self.noise.send(epoch.noise, recorder, now));
                 }
+                Published::NoFix(fix) => {
+                    log_failure(log, self.fix.send(*fix, recorder, now));
+                }
             }
         }
     }
