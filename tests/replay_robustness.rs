@@ -532,7 +532,7 @@ fn solutions_with_a_non_finite_value_or_a_negative_variance_are_counted_and_not_
                 let (pose, twist) = (&o.pose.covariance, &o.twist.covariance);
                 assert!((0..6).all(|k| pose[7 * k] >= 0.0 && twist[7 * k] >= 0.0));
             }
-            "/fix" => {
+            "/fix/filtered" => {
                 let f: NavSatFix = cdr::decode(&m.data).unwrap();
                 if f.status.status == NavSatStatus::STATUS_NO_FIX {
                     // A refused solution: no position, covariance unknown.

@@ -102,7 +102,7 @@ fn replay_outputs_carry_their_inputs_stamps_to_the_nanosecond() {
                 cdr::decode::<Odometry>(&m.data).unwrap().header.stamp,
                 &imu_stamps,
             ),
-            "/fix" => {
+            "/fix/filtered" => {
                 let fix: NavSatFix = cdr::decode(&m.data).unwrap();
                 services.insert(fix.status.service);
                 (fix.header.stamp, &imu_stamps)
@@ -125,7 +125,7 @@ fn replay_outputs_carry_their_inputs_stamps_to_the_nanosecond() {
     }
     let count = |topic: &str| counts.get(topic).copied().unwrap_or(0);
     assert!(count("/odometry") > 1000, "{counts:?}");
-    assert_eq!(count("/fix"), count("/odometry"));
+    assert_eq!(count("/fix/filtered"), count("/odometry"));
     assert_eq!(count("/tf"), count("/odometry"));
     assert!(count("/noise_estimates") > 20, "{counts:?}");
     // Every fix names only constellations the filter used (issue 16, item 4); those

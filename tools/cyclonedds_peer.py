@@ -148,7 +148,7 @@ class Peer:
         self.imu = ros_writer(f'{ns}/imu', ros.Imu)
         self.gnss = ros_writer(f'{ns}/gnss/measurements', ros.GnssMeasurements)
         self.odometry = ros_reader(f'{ns}/odometry', ros.Odometry)
-        self.fix = ros_reader(f'{ns}/fix', ros.NavSatFix)
+        self.fix = ros_reader(f'{ns}/fix/filtered', ros.NavSatFix)
         self.noise = ros_reader(f'{ns}/{node}/noise_estimates', ros.NoiseEstimates)
         self.diagnostics = ros_reader('/diagnostics', ros.DiagnosticArray)
         self.clock = ros_writer('/clock', ros.Clock)

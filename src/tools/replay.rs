@@ -19,7 +19,7 @@ use super::scoring::Scorer;
 
 /// Output topics of a replay.
 pub const ODOMETRY_TOPIC: &str = "/odometry";
-pub const FIX_OUT_TOPIC: &str = "/fix";
+pub const FIX_OUT_TOPIC: &str = "/fix/filtered";
 pub const NOISE_TOPIC: &str = "/noise_estimates";
 /// Only with `publish_tf`.
 pub const TF_TOPIC: &str = "/tf";
