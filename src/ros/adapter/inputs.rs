@@ -6,7 +6,7 @@ use crate::gnss::GnssEpoch;
 use crate::ins::ImuSample;
 use crate::ros::convert::GnssVelocity;
 use crate::ros::fix_velocity::{FramedFix, Joined, VelocityUse};
-use crate::ros::msg::{GnssMeasurements, Imu, NavSatFix, TwistWithCovarianceStamped};
+use crate::ros::msg::{GnssMeasurements, Imu, NavSatFix, Time, TwistWithCovarianceStamped};
 
 use super::frame_lock::Admission;
 use super::time_line::Verdict;
@@ -131,7 +131,21 @@ impl RosAdapter {
                 Vec::new()
             }
         };
-        self.publishable(outputs)
+        let mut published = self.publishable(outputs);
+        published.extend(self.no_fix_while_initializing(msg.header.stamp));
+        published
+    }
+
+    /// The NO_FIX NavSatFix at a GNSS input's `stamp` while the filter has no solution.
+    ///
+    /// Choice: one per GNSS input (the rate a receiver's fix would come at), not one per
+    /// IMU sample, and nothing on `odometry`, whose messages have no status.
+    fn no_fix_while_initializing(&self, stamp: Time) -> Option<Published> {
+        self.engine
+            .state()
+            .is_none()
+            .then(|| self.outputs.no_fix(stamp))
+            .flatten()
     }
 
     /// Handles one NavSatFix (loose coupling); a fix without a solution is counted and
@@ -153,7 +167,9 @@ impl RosAdapter {
             fix,
             frame_id: msg.header.frame_id.clone(),
         });
-        self.publish_fixes(released)
+        let mut published = self.publish_fixes(released);
+        published.extend(self.no_fix_while_initializing(msg.header.stamp));
+        published
     }
 
     /// Handles one velocity on `gnss/velocity` (loose coupling): it joins the fix of its

@@ -3,7 +3,7 @@
 
 use crate::earth::Llh;
 use crate::engine::{EpochReport, MeasurementKind, Output, Solution, StatusEvent};
-use crate::ros::msg::{NavSatFix, NavSatStatus, NoiseEstimates, Odometry, TFMessage};
+use crate::ros::msg::{NavSatFix, NavSatStatus, NoiseEstimates, Odometry, TFMessage, Time};
 use crate::ros::outbound;
 
 use super::guard::{self, Unpublishable};
@@ -43,8 +43,9 @@ pub enum Published {
     Solution(PublishedSolution),
     /// An epoch's report, on `~/noise_estimates`.
     Epoch(Box<PublishedEpoch>),
-    /// A solution the guard refused, on `fix` as `STATUS_NO_FIX` at its stamp: the filter
-    /// cannot tell its position then (see [`outbound::no_fix`]).
+    /// On `fix/filtered` as `STATUS_NO_FIX` (see [`outbound::no_fix`]): at the stamp of a
+    /// solution the guard refused, and of each GNSS input while the filter has no solution
+    /// (initializing, or after a reset until it starts again).
     NoFix(Box<NavSatFix>),
 }
 
@@ -132,11 +133,10 @@ impl Framing {
         }
     }
 
-    /// The NO_FIX NavSatFix of a solution at `t_s` the guard refused; None from an adapter
-    /// that frames no messages or for a time without a stamp.
-    fn no_fix(&self, t_s: f64, imu_stamps: &StampBook) -> Option<Box<NavSatFix>> {
-        let stamp = imu_stamps.stamp(t_s).ok().filter(|_| self.messages)?;
-        Some(Box::new(outbound::no_fix(stamp, &self.frames.base_frame)))
+    /// The NO_FIX NavSatFix at `stamp`; None from an adapter that frames no messages.
+    pub(super) fn no_fix(&self, stamp: Time) -> Option<Published> {
+        self.messages
+            .then(|| Published::NoFix(Box::new(outbound::no_fix(stamp, &self.frames.base_frame))))
     }
 
     pub(super) fn frames(&self) -> &OutputFrames {
@@ -208,8 +208,9 @@ impl RosAdapter {
                         }
                         Err(refused) => refused,
                     };
-                    let no_fix = self.outputs.no_fix(t_s, &self.imu_stamps);
-                    published.extend(no_fix.map(Published::NoFix));
+                    if let Ok(stamp) = self.imu_stamps.stamp(t_s) {
+                        published.extend(self.outputs.no_fix(stamp));
+                    }
                     match refused {
                         Unpublishable::NonFinite => {
                             self.counts.non_finite_outputs += 1;

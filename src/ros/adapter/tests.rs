@@ -628,7 +628,7 @@ fn outputs_carry_their_inputs_stamps_to_the_nanosecond() {
         }
         _ => {}
     });
-    let (mut solutions, mut reports) = (0, 0);
+    let (mut solutions, mut reports, mut no_fixes) = (0, 0, 0);
     for published in &out {
         match published {
             Published::Solution(s) => {
@@ -644,7 +644,16 @@ fn outputs_carry_their_inputs_stamps_to_the_nanosecond() {
                 assert_eq!(m.tf.as_ref().unwrap().transforms[0].header.stamp, stamp);
                 solutions += 1;
             }
-            Published::NoFix(f) => panic!("no solution refused here: {f:?}"),
+            Published::NoFix(f) => {
+                // Only while initializing, at a fix's stamp.
+                assert_eq!(solutions, 0, "NO_FIX after the start: {f:?}");
+                assert!(
+                    fix_stamps.contains(&f.header.stamp),
+                    "NO_FIX at {:?}",
+                    f.header
+                );
+                no_fixes += 1;
+            }
             Published::Epoch(e) => {
                 let stamp = e.noise.header.stamp;
                 assert!(fix_stamps.contains(&stamp), "NoiseEstimates at {stamp:?}");
@@ -656,6 +665,7 @@ fn outputs_carry_their_inputs_stamps_to_the_nanosecond() {
         solutions > 2000 && reports > 25,
         "{solutions} solutions, {reports} reports"
     );
+    assert!(no_fixes > 0, "the fixes before the start say NO_FIX");
 }
 
 #[test]
