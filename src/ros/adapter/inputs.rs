@@ -141,11 +141,10 @@ impl RosAdapter {
     /// Choice: one per GNSS input (the rate a receiver's fix would come at), not one per
     /// IMU sample, and nothing on `odometry`, whose messages have no status.
     fn no_fix_while_initializing(&self, stamp: Time) -> Option<Published> {
-        self.engine
-            .state()
-            .is_none()
-            .then(|| self.outputs.no_fix(stamp))
-            .flatten()
+        if self.engine.state().is_some() {
+            return None;
+        }
+        self.outputs.no_fix(stamp)
     }
 
     /// Handles one NavSatFix (loose coupling); a fix without a solution is counted and

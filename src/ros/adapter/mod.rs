@@ -10,8 +10,10 @@
 //! the join releases at this IMU time) → [`Engine::push_imu`] (mechanization and
 //! covariance propagation, a [`Solution`](crate::engine::Solution) per sample or at
 //! `output.rate_hz`) → `outputs` (the guard: every number finite, no negative variance;
-//! then Odometry, NavSatFix and, with `publish_tf`, the TF) → [`Published::Solution`],
-//! which keeps the solution for `replay`'s CSV and scoring.
+//! then Odometry, NavSatFix and, with `publish_tf`, the TF, stamped with the sample's
+//! own ROS stamp from `stamp_book`) → [`Published::Solution`], which keeps the solution
+//! for `replay`'s CSV and scoring; a refused one, or a GNSS input while the filter has
+//! no solution, becomes [`Published::NoFix`].
 //!
 //! Data flow of one GNSS epoch: `GnssMeasurements` → [`RosAdapter::on_gnss`] (conversion
 //! [`GnssEpoch::try_from`](crate::gnss::GnssEpoch), frame lock) → [`Engine::push_gnss`]
