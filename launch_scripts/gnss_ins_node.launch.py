@@ -12,8 +12,10 @@ Arguments:
   every parameter at its default): a preset of params/ (they hold only what differs from
   the manual) or a file of your own; default: the manual itself (loaded once).
   namespace, node_name, log_level;
-- imu_topic, gnss_topic, fix_topic, velocity_topic, odometry_topic: remappings of the
-  node's relative topics imu, gnss/measurements, gnss/fix, gnss/velocity and odometry;
+- imu_topic, gnss_topic, fix_topic, velocity_topic, odometry_topic, filtered_fix_topic:
+  remappings of the node's relative topics imu, gnss/measurements, gnss/fix,
+  gnss/velocity, odometry and fix/filtered (its NavSatFix, named apart from a driver's
+  fix in the same namespace);
 - the node's own parameters use_sim_time (bool), map_frame, base_frame (frame ids),
   publish_tf (bool), queue_depth (int) and imu_frame (a frame id). Their default is ''
   meaning "not set": the value then comes from the params file or, when the file has
@@ -85,6 +87,7 @@ TOPIC_REMAPS = {
     'fix_topic': 'gnss/fix',
     'velocity_topic': 'gnss/velocity',
     'odometry_topic': 'odometry',
+    'filtered_fix_topic': 'fix/filtered',
 }
 
 

@@ -75,6 +75,7 @@ fn python_launch_file_parses_and_names_existing_things() {
         "gnss/fix",
         "gnss/velocity",
         "odometry",
+        "fix/filtered",
     ] {
         assert!(
             text.contains(&format!("': '{topic}',")),

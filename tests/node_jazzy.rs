@@ -147,9 +147,8 @@ fn jazzy_parameter_client_lists_describes_and_sets_parameters() {
 
 /// A 200 Hz Imu at rest from rclpy, stamped in 2025 at x.0025 s and (every other sample)
 /// one nanosecond later, with a 5 Hz fix, into the loosely-coupled node: every sample from
-/// the start on gets one Odometry and one NavSatFix within 1 us of its stamp. Exact stamps
-/// are not yet asserted (issue 16: time goes through f64 seconds; `--exact-stamps` checks
-/// them); the mismatch and the latency are printed.
+/// the start on gets one Odometry and one NavSatFix carrying exactly its stamp
+/// (`--exact-stamps`; issue 16, item 3); the latency is printed.
 #[test]
 fn jazzy_imu_at_200_hz_gets_one_output_per_sample_at_its_stamp() {
     let python = venv_support::python();
@@ -162,6 +161,10 @@ fn jazzy_imu_at_200_hz_gets_one_output_per_sample_at_its_stamp() {
         "-p",
         "init.heading_deg:=90.0",
     ]);
-    let summary = run_peer(&python, "jazzy_stamps.py", &["--duration-s", "8"]);
+    let summary = run_peer(
+        &python,
+        "jazzy_stamps.py",
+        &["--duration-s", "8", "--exact-stamps"],
+    );
     assert!(summary["odometry_stamps"]["count"].as_u64().unwrap_or(0) > 1000);
 }

@@ -259,7 +259,7 @@ fn node_records_the_replay_solution(
         .collect();
     for want in [
         "/odometry",
-        "/fix",
+        "/fix/filtered",
         "/gnss_ins_node/noise_estimates",
         "/diagnostics",
     ] {

@@ -16,7 +16,8 @@ use adaptive_gnss_ins::engine::RejectionReason;
 use adaptive_gnss_ins::ros::bag::{BagReader, BagWriteOptions, BagWriter};
 use adaptive_gnss_ins::ros::cdr;
 use adaptive_gnss_ins::ros::msg::{
-    DiagnosticArray, GnssMeasurements, Imu, NavSatFix, NoiseEstimates, Odometry, RosMessage,
+    DiagnosticArray, GnssMeasurements, Imu, NavSatFix, NavSatStatus, NoiseEstimates, Odometry,
+    RosMessage,
 };
 use adaptive_gnss_ins::tools::bag_run::BagRun;
 use adaptive_gnss_ins::tools::replay::TruthSource;
@@ -542,7 +543,7 @@ fn solutions_with_a_non_finite_value_or_a_negative_variance_are_counted_and_not_
     assert!(!rows.is_empty());
     assert_eq!(rows.len(), result.report.solutions);
     assert!(rows.iter().flatten().all(|v| v.is_finite()));
-    let (mut odometry, mut fixes) = (0, 0);
+    let (mut odometry, mut fixes, mut no_fixes) = (0, 0, 0);
     for m in BagReader::open(&out).unwrap().messages().unwrap() {
         let m = m.unwrap();
         match m.topic.as_str() {
@@ -553,9 +554,19 @@ fn solutions_with_a_non_finite_value_or_a_negative_variance_are_counted_and_not_
                 let (pose, twist) = (&o.pose.covariance, &o.twist.covariance);
                 assert!((0..6).all(|k| pose[7 * k] >= 0.0 && twist[7 * k] >= 0.0));
             }
-            "/fix" => {
-                fixes += 1;
+            "/fix/filtered" => {
                 let f: NavSatFix = cdr::decode(&m.data).unwrap();
+                if f.status.status == NavSatStatus::STATUS_NO_FIX {
+                    // No position, covariance unknown.
+                    no_fixes += 1;
+                    assert!(f.latitude.is_nan() && f.longitude.is_nan() && f.altitude.is_nan());
+                    assert_eq!(
+                        f.position_covariance_type,
+                        NavSatFix::COVARIANCE_TYPE_UNKNOWN
+                    );
+                    continue;
+                }
+                fixes += 1;
                 let mut values = vec![f.latitude, f.longitude, f.altitude];
                 values.extend(f.position_covariance);
                 assert!(values.iter().all(|v| v.is_finite()), "{f:?}");
@@ -565,4 +576,7 @@ fn solutions_with_a_non_finite_value_or_a_negative_variance_are_counted_and_not_
         }
     }
     assert_eq!((odometry, fixes), (rows.len(), rows.len()));
+    // Every refused solution says NO_FIX at its stamp (and so do the epochs before the
+    // start and after a reset, at theirs).
+    assert!(no_fixes >= non_finite + negative, "{no_fixes} NO_FIX");
 }

@@ -200,7 +200,7 @@ def main():
             list(o.twist.covariance)
         if not checks.that(all(math.isfinite(v) for v in numbers), 'NaN in Odometry'):
             break
-    for f in fixes:
+    for f in (f for f in fixes if f.status.status != -1):  # NO_FIX (NaN) while starting
         numbers = [f.latitude, f.longitude, f.altitude] + list(f.position_covariance)
         if not checks.that(all(math.isfinite(v) for v in numbers), 'NaN in NavSatFix'):
             break

@@ -148,7 +148,7 @@ class Peer:
         self.imu = ros_writer(f'{ns}/imu', ros.Imu)
         self.gnss = ros_writer(f'{ns}/gnss/measurements', ros.GnssMeasurements)
         self.odometry = ros_reader(f'{ns}/odometry', ros.Odometry)
-        self.fix = ros_reader(f'{ns}/fix', ros.NavSatFix)
+        self.fix = ros_reader(f'{ns}/fix/filtered', ros.NavSatFix)
         self.noise = ros_reader(f'{ns}/{node}/noise_estimates', ros.NoiseEstimates)
         self.diagnostics = ros_reader('/diagnostics', ros.DiagnosticArray)
         self.clock = ros_writer('/clock', ros.Clock)
@@ -280,9 +280,20 @@ def check_odometry(checks, odometry, truth):
             'max_error_over_sigma_3d': worst_ratio}
 
 
+NO_FIX = -1  # sensor_msgs/NavSatStatus STATUS_NO_FIX
+
+
 def check_fixes(checks, fixes, odometry, datum):
-    """Every NavSatFix is finite and sits where the Odometry of the same stamp does."""
+    """Every NavSatFix is finite and sits where the Odometry of the same stamp does, except
+    those saying NO_FIX (NaN, covariance UNKNOWN) while the filter starts."""
     by_stamp = {(o.header.stamp.sec, o.header.stamp.nanosec): o for o in odometry}
+    no_fix = [f for f in fixes if f.status.status == NO_FIX]
+    first_odometry = min((seconds(o.header.stamp) for o in odometry), default=math.inf)
+    for f in no_fix:
+        checks.that(f.position_covariance_type == 0 and math.isnan(f.latitude)
+                    and seconds(f.header.stamp) <= first_odometry,
+                    f'NO_FIX at {seconds(f.header.stamp)}: type {f.position_covariance_type}')
+    fixes = [f for f in fixes if f.status.status != NO_FIX]
     worst = 0.0
     for f in fixes:
         values = [f.latitude, f.longitude, f.altitude] + list(f.position_covariance)
@@ -301,7 +312,7 @@ def check_fixes(checks, fixes, odometry, datum):
     checks.that(worst < 1e-3, f'NavSatFix and Odometry of one stamp differ by {worst} m')
     checks.that(len(fixes) == len(odometry),
                 f'{len(fixes)} NavSatFix for {len(odometry)} Odometry')
-    return {'count': len(fixes), 'max_fix_vs_odometry_m': worst}
+    return {'count': len(fixes), 'no_fix': len(no_fix), 'max_fix_vs_odometry_m': worst}
 
 
 def check_noise(checks, noise, epochs_sent, variant):

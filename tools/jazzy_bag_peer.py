@@ -40,7 +40,7 @@ from rosgraph_msgs.msg import Clock  # noqa: E402
 from sensor_msgs.msg import Imu, NavSatFix  # noqa: E402
 
 INPUTS = {'/imu': Imu, '/gnss/fix': NavSatFix, '/gnss/velocity': TwistWithCovarianceStamped}
-OUTPUTS = {'/odometry': Odometry, '/fix': NavSatFix}
+OUTPUTS = {'/odometry': Odometry, '/fix/filtered': NavSatFix}
 # The bag's time goes on /clock every this many IMU samples.
 CLOCK_EVERY_IMU = 10
 # Added to the bag time on /clock, so that a node converting it through f64 seconds would
@@ -66,7 +66,7 @@ class Peer:
                            for topic, kind in INPUTS.items()}
         self.clock = n.create_publisher(Clock, '/clock', reliable(100))
         self.jazzy.subscribe('odometry', Odometry, f'{ns}/odometry', reliable(depth))
-        self.jazzy.subscribe('fix', NavSatFix, f'{ns}/fix', reliable(depth))
+        self.jazzy.subscribe('fix', NavSatFix, f'{ns}/fix/filtered', reliable(depth))
         self.jazzy.subscribe('diagnostics', DiagnosticArray, '/diagnostics', reliable(depth))
         self.jazzy.subscribe('rosout', Log, '/rosout', rosout_reader())
         self.fqn = node_fqn(namespace, node)
@@ -225,7 +225,7 @@ def run(args, peer, inputs, replayed):
     summary['sent'], clocks_ns = stream(peer, inputs, args.speed, args.sim_time)
     summary['stream_wall_s'] = time.monotonic() - start
     expected_odometry = [m for _, t, m in replayed if t == '/odometry']
-    expected_fix = [m for _, t, m in replayed if t == '/fix']
+    expected_fix = [m for _, t, m in replayed if t == '/fix/filtered']
 
     def complete():
         done = len(peer.jazzy.received['odometry']) >= len(expected_odometry)

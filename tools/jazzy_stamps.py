@@ -7,7 +7,7 @@ Publishes, in real time, a 200 Hz sensor_msgs/Imu of a device at rest (sensor-da
 IMU drivers do) stamped in this decade at x.0025 s, x.0075 s, ... with every other stamp one
 nanosecond later (…2500001 ns), and a 5 Hz sensor_msgs/NavSatFix stamped at x.0 s, x.2 s,
 ... plus one nanosecond, to the node under NS (run loosely coupled with a given heading:
-`-p filter.coupling:=loose -p init.heading_deg:=90.0`). Subscribes `odometry` and `fix` and
+`-p filter.coupling:=loose -p init.heading_deg:=90.0`). Subscribes `odometry` and `fix/filtered` and
 measures, for every output, how its stamp compares with the nearest input stamp (each output
 is computed at an IMU sample) and the latency from publishing that Imu to receiving its
 Odometry (p50/p90/p99/max, including rclpy's own publish and take).
@@ -158,7 +158,7 @@ def main():
     imu = jazzy.node.create_publisher(Imu, f'{ns}/imu', qos_profile_sensor_data)
     gnss = jazzy.node.create_publisher(NavSatFix, f'{ns}/gnss/fix', qos_profile_sensor_data)
     jazzy.subscribe('odometry', Odometry, f'{ns}/odometry', reliable(10_000))
-    jazzy.subscribe('fix', NavSatFix, f'{ns}/fix', reliable(10_000))
+    jazzy.subscribe('fix', NavSatFix, f'{ns}/fix/filtered', reliable(10_000))
     jazzy.subscribe('diagnostics', DiagnosticArray, '/diagnostics', reliable(100))
     jazzy.start()
     try:
@@ -175,6 +175,9 @@ def main():
                                for m in jazzy.messages('odometry')), 2.0)
         time.sleep(0.2)
         odometry, fixes = jazzy.received['odometry'], jazzy.received['fix']
+        # The fixes before the start say NO_FIX at the GNSS fix's stamp, not an IMU's.
+        summary['no_fix'] = sum(m.status.status == m.status.STATUS_NO_FIX for _, m in fixes)
+        fixes = [(t, m) for t, m in fixes if m.status.status != m.status.STATUS_NO_FIX]
         summary['imu_published'] = len(published)
         summary['odometry_stamps'] = stamp_summary('Odometry', odometry, published,
                                                    args.exact_stamps, checks)

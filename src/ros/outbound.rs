@@ -8,6 +8,7 @@ use nalgebra::{Matrix3, SMatrix};
 
 use crate::earth::{self, Llh};
 use crate::engine::{EpochReport, SatRejection, Solution};
+use crate::gnss::Constellation;
 use crate::ins::error_state::{DV, GYRO_BIAS, GYRO_GM};
 
 use super::msg::{
@@ -113,8 +114,9 @@ pub fn transform(odometry: &Odometry) -> TFMessage {
     }
 }
 
-/// sensor_msgs/NavSatFix of the body position, with its ENU covariance (known).
-pub fn nav_sat_fix(solution: &Solution, stamp: Time, frame_id: &str) -> NavSatFix {
+/// sensor_msgs/NavSatFix of the body position, with the filter's ENU covariance (known);
+/// `service` holds the bits of the constellations the filter used ([`service_of`]).
+pub fn nav_sat_fix(solution: &Solution, stamp: Time, frame_id: &str, service: u16) -> NavSatFix {
     let p = &solution.nav.p;
     let cov = solution.position_covariance_enu_m2();
     NavSatFix {
@@ -124,7 +126,7 @@ pub fn nav_sat_fix(solution: &Solution, stamp: Time, frame_id: &str) -> NavSatFi
         },
         status: NavSatStatus {
             status: NavSatStatus::STATUS_FIX,
-            service: NavSatStatus::SERVICE_GPS,
+            service,
         },
         latitude: p.lat_rad.to_degrees(),
         longitude: p.lon_rad.to_degrees(),
@@ -132,6 +134,46 @@ pub fn nav_sat_fix(solution: &Solution, stamp: Time, frame_id: &str) -> NavSatFi
         position_covariance: std::array::from_fn(|k| cov[(k / 3, k % 3)]),
         position_covariance_type: NavSatFix::COVARIANCE_TYPE_KNOWN,
     }
+}
+
+/// sensor_msgs/NavSatFix saying the filter has no position at `stamp` (a solution it
+/// could not publish: a value not finite, a negative variance).
+///
+/// Choice: `STATUS_NO_FIX`, the position NaN (no number is a confident wrong answer; the
+/// message's own convention for an unknown altitude) and covariance type `UNKNOWN`.
+pub fn no_fix(stamp: Time, frame_id: &str) -> NavSatFix {
+    NavSatFix {
+        header: Header {
+            stamp,
+            frame_id: frame_id.to_owned(),
+        },
+        status: NavSatStatus {
+            status: NavSatStatus::STATUS_NO_FIX,
+            service: NavSatStatus::SERVICE_UNKNOWN,
+        },
+        latitude: f64::NAN,
+        longitude: f64::NAN,
+        altitude: f64::NAN,
+        position_covariance: [0.0; 9],
+        position_covariance_type: NavSatFix::COVARIANCE_TYPE_UNKNOWN,
+    }
+}
+
+/// The `NavSatStatus` service bits of the constellations in `used`.
+///
+/// Choice: QZSS and SBAS have no bit of their own in `NavSatStatus` (GPS, GLONASS, COMPASS
+/// for BeiDou, GALILEO) and add none rather than claim GPS.
+pub fn service_of(used: impl IntoIterator<Item = Constellation>) -> u16 {
+    used.into_iter()
+        .fold(NavSatStatus::SERVICE_UNKNOWN, |bits, c| {
+            bits | match c {
+                Constellation::Gps => NavSatStatus::SERVICE_GPS,
+                Constellation::Glonass => NavSatStatus::SERVICE_GLONASS,
+                Constellation::Galileo => NavSatStatus::SERVICE_GALILEO,
+                Constellation::Beidou => NavSatStatus::SERVICE_COMPASS,
+                Constellation::Qzss | Constellation::Sbas => NavSatStatus::SERVICE_UNKNOWN,
+            }
+        })
 }
 
 fn rejection_code(reason: Option<SatRejection>) -> u8 {
@@ -389,12 +431,34 @@ mod tests {
     #[test]
     fn nav_sat_fix_carries_degrees_and_the_enu_covariance() {
         let (sol, _) = solution();
-        let fix = nav_sat_fix(&sol, Time::default(), "base_link");
+        let fix = nav_sat_fix(&sol, Time::default(), "base_link", 9);
         assert!((fix.latitude - sol.nav.p.lat_rad.to_degrees()).abs() < 1e-12);
+        assert_eq!(fix.status.status, NavSatStatus::STATUS_FIX);
+        assert_eq!(fix.status.service, 9);
         assert!((fix.position_covariance[4] - 4.0).abs() < 1e-9);
         assert_eq!(
             fix.position_covariance_type,
             NavSatFix::COVARIANCE_TYPE_KNOWN
+        );
+    }
+
+    #[test]
+    fn service_bits_name_the_constellations_used() {
+        use Constellation::*;
+        assert_eq!(service_of([]), NavSatStatus::SERVICE_UNKNOWN);
+        assert_eq!(service_of([Gps, Gps, Qzss]), NavSatStatus::SERVICE_GPS);
+        assert_eq!(
+            service_of([Galileo, Beidou, Glonass, Sbas]),
+            NavSatStatus::SERVICE_GALILEO
+                | NavSatStatus::SERVICE_COMPASS
+                | NavSatStatus::SERVICE_GLONASS
+        );
+        let none = no_fix(Time::default(), "base_link");
+        assert_eq!(none.status.status, NavSatStatus::STATUS_NO_FIX);
+        assert!(none.latitude.is_nan() && none.altitude.is_nan());
+        assert_eq!(
+            none.position_covariance_type,
+            NavSatFix::COVARIANCE_TYPE_UNKNOWN
         );
     }
 

@@ -51,7 +51,7 @@ pub enum Command {
         /// params/ermakf.yaml (a later value wins). Defaults when absent.
         #[arg(long)]
         params: Vec<PathBuf>,
-        /// Output bag with /odometry, /fix and /noise_estimates.
+        /// Output bag with /odometry, /fix/filtered and /noise_estimates.
         #[arg(long)]
         out: Option<PathBuf>,
         /// zstd-compress the output bag's chunks: half the size, for about 1.5 s more CPU

@@ -19,7 +19,7 @@ use super::scoring::Scorer;
 
 /// Output topics of a replay.
 pub const ODOMETRY_TOPIC: &str = "/odometry";
-pub const FIX_OUT_TOPIC: &str = "/fix";
+pub const FIX_OUT_TOPIC: &str = "/fix/filtered";
 pub const NOISE_TOPIC: &str = "/noise_estimates";
 /// Only with `publish_tf`.
 pub const TF_TOPIC: &str = "/tf";
@@ -196,6 +196,9 @@ impl ReplayOutputs {
                 Published::Epoch(epoch) => {
                     let noise = &epoch.noise;
                     w.write(NOISE_TOPIC, noise, log_time_ns(&noise.header.stamp))?;
+                }
+                Published::NoFix(fix) => {
+                    w.write(FIX_OUT_TOPIC, fix.as_ref(), log_time_ns(&fix.header.stamp))?;
                 }
             }
         }

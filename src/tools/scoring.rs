@@ -147,6 +147,7 @@ impl Scorer {
         match published {
             Published::Solution(s) => self.on_solution(s.solution),
             Published::Epoch(epoch) => self.on_epoch(&epoch.report),
+            Published::NoFix(_) => {}
         }
     }
 

@@ -6,7 +6,7 @@ use crate::gnss::GnssEpoch;
 use crate::ins::ImuSample;
 use crate::ros::convert::GnssVelocity;
 use crate::ros::fix_velocity::{FramedFix, Joined, VelocityUse};
-use crate::ros::msg::{GnssMeasurements, Imu, NavSatFix, TwistWithCovarianceStamped};
+use crate::ros::msg::{GnssMeasurements, Imu, NavSatFix, Time, TwistWithCovarianceStamped};
 
 use super::frame_lock::Admission;
 use super::time_line::Verdict;
@@ -48,6 +48,7 @@ impl RosAdapter {
             Ok(s) => s,
             Err(e) => return self.unconvertible(Input::Imu, &e.to_string()),
         };
+        self.imu_stamps.note(sample.t_s, msg.header.stamp);
         let frame_id = &msg.header.frame_id;
         let mut outputs = Vec::new();
         match self.imu_frame.admit(frame_id) {
@@ -114,6 +115,7 @@ impl RosAdapter {
             Ok(e) => e,
             Err(e) => return self.unconvertible(Input::Gnss, &e.to_string()),
         };
+        self.measurement_stamps.note(epoch.t_s, msg.header.stamp);
         match self.gnss_frame.admit(&msg.header.frame_id) {
             Admission::Admitted => {}
             Admission::Foreign => return self.foreign_frame(Input::Gnss, &msg.header.frame_id),
@@ -129,7 +131,20 @@ impl RosAdapter {
                 Vec::new()
             }
         };
-        self.publishable(outputs)
+        let mut published = self.publishable(outputs);
+        published.extend(self.no_fix_while_initializing(msg.header.stamp));
+        published
+    }
+
+    /// The NO_FIX NavSatFix at a GNSS input's `stamp` while the filter has no solution.
+    ///
+    /// Choice: one per GNSS input (the rate a receiver's fix would come at), not one per
+    /// IMU sample, and nothing on `odometry`, whose messages have no status.
+    fn no_fix_while_initializing(&self, stamp: Time) -> Option<Published> {
+        if self.engine.state().is_some() {
+            return None;
+        }
+        self.outputs.no_fix(stamp)
     }
 
     /// Handles one NavSatFix (loose coupling); a fix without a solution is counted and
@@ -140,16 +155,20 @@ impl RosAdapter {
             Ok(f) => f,
             Err(e) => return self.unconvertible(Input::Fix, &e.to_string()),
         };
+        self.measurement_stamps.note(fix.t_s, msg.header.stamp);
         match self.fix_frame.admit(&msg.header.frame_id) {
             Admission::Admitted => {}
             Admission::Foreign => return self.foreign_frame(Input::Fix, &msg.header.frame_id),
             Admission::Switched => self.frame_switched(Input::Fix, &msg.header.frame_id),
         }
+        self.outputs.fix_received(msg.status.service);
         let released = self.pairing.on_fix(FramedFix {
             fix,
             frame_id: msg.header.frame_id.clone(),
         });
-        self.publish_fixes(released)
+        let mut published = self.publish_fixes(released);
+        published.extend(self.no_fix_while_initializing(msg.header.stamp));
+        published
     }
 
     /// Handles one velocity on `gnss/velocity` (loose coupling): it joins the fix of its

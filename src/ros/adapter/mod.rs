@@ -10,8 +10,10 @@
 //! the join releases at this IMU time) → [`Engine::push_imu`] (mechanization and
 //! covariance propagation, a [`Solution`](crate::engine::Solution) per sample or at
 //! `output.rate_hz`) → `outputs` (the guard: every number finite, no negative variance;
-//! then Odometry, NavSatFix and, with `publish_tf`, the TF) → [`Published::Solution`],
-//! which keeps the solution for `replay`'s CSV and scoring.
+//! then Odometry, NavSatFix and, with `publish_tf`, the TF, stamped with the sample's
+//! own ROS stamp from `stamp_book`) → [`Published::Solution`], which keeps the solution
+//! for `replay`'s CSV and scoring; a refused one, or a GNSS input while the filter has
+//! no solution, becomes [`Published::NoFix`].
 //!
 //! Data flow of one GNSS epoch: `GnssMeasurements` → [`RosAdapter::on_gnss`] (conversion
 //! [`GnssEpoch::try_from`](crate::gnss::GnssEpoch), frame lock) → [`Engine::push_gnss`]
@@ -30,6 +32,7 @@ mod frame_lock;
 mod guard;
 mod inputs;
 mod outputs;
+mod stamp_book;
 #[cfg(test)]
 mod tests;
 mod time_line;
@@ -43,6 +46,7 @@ pub use counts::{Input, InputCounts};
 use frame_lock::FrameLock;
 pub use inputs::InputMessage;
 pub use outputs::{OutputFrames, Published, PublishedEpoch, PublishedSolution, SolutionMessages};
+use stamp_book::StampBook;
 use time_line::TimeLine;
 pub use time_line::{TIME_JUMP_BACK_S, TIME_JUMP_CONFIRM_SAMPLES};
 
@@ -57,6 +61,10 @@ pub struct RosAdapter {
     fix_frame: FrameLock,
     pairing: FixVelocityJoin,
     outputs: outputs::Framing,
+    /// The stamps of the IMU samples, which solutions carry.
+    imu_stamps: StampBook,
+    /// The stamps of the GNSS epochs and fixes, which their reports carry.
+    measurement_stamps: StampBook,
 }
 
 impl RosAdapter {
@@ -72,6 +80,8 @@ impl RosAdapter {
             time_line: TimeLine::default(),
             gnss_frame: FrameLock::default(),
             fix_frame: FrameLock::default(),
+            imu_stamps: StampBook::default(),
+            measurement_stamps: StampBook::default(),
         }
     }
 

@@ -2,12 +2,12 @@
 //! TF, behind the guard ([`super::guard`]); status events are logged.
 
 use crate::earth::Llh;
-use crate::engine::{EpochReport, Output, Solution, StatusEvent};
-use crate::ros::convert::seconds_to_time;
-use crate::ros::msg::{NavSatFix, NoiseEstimates, Odometry, TFMessage};
+use crate::engine::{EpochReport, MeasurementKind, Output, Solution, StatusEvent};
+use crate::ros::msg::{NavSatFix, NavSatStatus, NoiseEstimates, Odometry, TFMessage, Time};
 use crate::ros::outbound;
 
 use super::guard::{self, Unpublishable};
+use super::stamp_book::StampBook;
 use super::RosAdapter;
 
 /// The frames of the published messages and whether the TF is published.
@@ -43,6 +43,10 @@ pub enum Published {
     Solution(PublishedSolution),
     /// An epoch's report, on `~/noise_estimates`.
     Epoch(Box<PublishedEpoch>),
+    /// On `fix/filtered` as `STATUS_NO_FIX` (see [`outbound::no_fix`]): at the stamp of a
+    /// solution the guard refused, and of each GNSS input while the filter has no solution
+    /// (initializing, or after a reset until it starts again).
+    NoFix(Box<NavSatFix>),
 }
 
 /// An epoch's report and its message.
@@ -83,6 +87,10 @@ pub(super) struct Framing {
     datum: Option<Llh>,
     /// Whether solutions are framed into messages.
     messages: bool,
+    /// NavSatFix service bits of the last update that used a measurement.
+    service: u16,
+    /// NavSatFix service bits of the last receiver fix received (loose coupling).
+    fix_service: u16,
 }
 
 impl Framing {
@@ -91,7 +99,44 @@ impl Framing {
             frames,
             datum,
             messages: true,
+            service: NavSatStatus::SERVICE_UNKNOWN,
+            fix_service: NavSatStatus::SERVICE_UNKNOWN,
         }
+    }
+
+    /// Remembers the service bits of a receiver fix, which its update will have used.
+    pub(super) fn fix_received(&mut self, service: u16) {
+        self.fix_service = service;
+    }
+
+    /// Takes the constellations `report` used as the solutions' service from now on.
+    ///
+    /// Choice: an update that used nothing keeps the last service (the solutions coast on
+    /// the IMU, their covariance grows); a loosely-coupled update used the receiver's
+    /// fix, which names its own service.
+    fn used(&mut self, report: &EpochReport) {
+        if report.measurements_used == 0 {
+            return;
+        }
+        let service = match report.kind {
+            MeasurementKind::Pseudoranges => outbound::service_of(
+                report
+                    .satellites
+                    .iter()
+                    .filter(|s| s.used_pseudorange || s.used_rate)
+                    .map(|s| s.sat.constellation),
+            ),
+            MeasurementKind::Fix => self.fix_service,
+        };
+        if service != NavSatStatus::SERVICE_UNKNOWN {
+            self.service = service;
+        }
+    }
+
+    /// The NO_FIX NavSatFix at `stamp`; None from an adapter that frames no messages.
+    pub(super) fn no_fix(&self, stamp: Time) -> Option<Published> {
+        self.messages
+            .then(|| Published::NoFix(Box::new(outbound::no_fix(stamp, &self.frames.base_frame))))
     }
 
     pub(super) fn frames(&self) -> &OutputFrames {
@@ -110,22 +155,34 @@ impl Framing {
     /// again for an overflow or for a negative variance of the twist's rotated velocity
     /// covariance (a velocity block that is no covariance any more: a diverged filter;
     /// 10 of 1979 dropped solutions in the replay test of issue 12, item 7).
-    fn solution(&mut self, solution: Box<Solution>) -> Result<PublishedSolution, Unpublishable> {
+    ///
+    /// The messages carry the stamp `imu_stamps` holds for the solution's time.
+    fn solution(
+        &mut self,
+        solution: Box<Solution>,
+        imu_stamps: &StampBook,
+    ) -> Result<PublishedSolution, Unpublishable> {
         guard::judge(&solution)?;
         let messages = if self.messages {
-            Some(Box::new(self.messages_of(&solution)?))
+            Some(Box::new(self.messages_of(&solution, imu_stamps)?))
         } else {
             None
         };
         Ok(PublishedSolution { solution, messages })
     }
 
-    fn messages_of(&mut self, solution: &Solution) -> Result<SolutionMessages, Unpublishable> {
-        let stamp = seconds_to_time(solution.nav.t_s).map_err(|_| Unpublishable::NonFinite)?;
+    fn messages_of(
+        &mut self,
+        solution: &Solution,
+        imu_stamps: &StampBook,
+    ) -> Result<SolutionMessages, Unpublishable> {
+        let stamp = imu_stamps
+            .stamp(solution.nav.t_s)
+            .map_err(|_| Unpublishable::NonFinite)?;
         let datum = *self.datum.get_or_insert(solution.nav.p);
         let f = &self.frames;
         let odometry = outbound::odometry(solution, &datum, stamp, &f.map_frame, &f.base_frame);
-        let fix = outbound::nav_sat_fix(solution, stamp, &f.base_frame);
+        let fix = outbound::nav_sat_fix(solution, stamp, &f.base_frame, self.service);
         guard::judge_messages(&odometry, &fix)?;
         Ok(SolutionMessages {
             tf: f.publish_tf.then(|| outbound::transform(&odometry)),
@@ -142,25 +199,38 @@ impl RosAdapter {
         let mut published = Vec::with_capacity(outputs.len());
         for output in outputs {
             match output {
-                Output::Solution(solution) => match self.outputs.solution(solution) {
-                    Ok(s) => published.push(Published::Solution(s)),
-                    Err(Unpublishable::NonFinite) => {
-                        self.counts.non_finite_outputs += 1;
-                        self.log.warn(
-                            "non_finite_output",
-                            "solution with a non-finite value dropped",
-                        );
+                Output::Solution(solution) => {
+                    let t_s = solution.nav.t_s;
+                    let refused = match self.outputs.solution(solution, &self.imu_stamps) {
+                        Ok(s) => {
+                            published.push(Published::Solution(s));
+                            continue;
+                        }
+                        Err(refused) => refused,
+                    };
+                    if let Ok(stamp) = self.imu_stamps.stamp(t_s) {
+                        published.extend(self.outputs.no_fix(stamp));
                     }
-                    Err(Unpublishable::NegativeVariance) => {
-                        self.counts.negative_variance_outputs += 1;
-                        self.log.warn(
-                            "negative_variance_output",
-                            "solution with a negative variance dropped",
-                        );
+                    match refused {
+                        Unpublishable::NonFinite => {
+                            self.counts.non_finite_outputs += 1;
+                            self.log.warn(
+                                "non_finite_output",
+                                "solution with a non-finite value dropped",
+                            );
+                        }
+                        Unpublishable::NegativeVariance => {
+                            self.counts.negative_variance_outputs += 1;
+                            self.log.warn(
+                                "negative_variance_output",
+                                "solution with a negative variance dropped",
+                            );
+                        }
                     }
-                },
+                }
                 Output::Epoch(report) => {
-                    if let Ok(stamp) = seconds_to_time(report.t_s) {
+                    self.outputs.used(&report);
+                    if let Ok(stamp) = self.measurement_stamps.stamp(report.t_s) {
                         let noise = outbound::noise_estimates(
                             &report,
                             stamp,

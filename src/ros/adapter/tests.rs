@@ -3,10 +3,12 @@
 use nalgebra::Matrix3;
 
 use super::*;
-use crate::engine::RejectionReason;
+use crate::engine::{Output, RejectionReason};
 use crate::ins::ImuSample;
 use crate::ros::convert::seconds_to_time;
-use crate::ros::msg::{DiagnosticStatus, Imu, NavSatFix, Time, TwistWithCovarianceStamped};
+use crate::ros::msg::{
+    DiagnosticStatus, Imu, NavSatFix, NavSatStatus, Time, TwistWithCovarianceStamped,
+};
 use crate::ros::outbound;
 
 fn imu_at(t_s: f64) -> Imu {
@@ -22,7 +24,7 @@ fn imu_at(t_s: f64) -> Imu {
 fn messages(published: &Published) -> Option<&SolutionMessages> {
     match published {
         Published::Solution(s) => s.messages.as_deref(),
-        Published::Epoch(_) => None,
+        Published::Epoch(_) | Published::NoFix(_) => None,
     }
 }
 
@@ -583,4 +585,120 @@ fn a_flood_of_imu_samples_and_far_future_measurements_keep_the_buffers_bounded()
             .count(RejectionReason::MeasurementQueueFull),
         2 * MAX_PENDING_MEASUREMENTS as u64
     );
+}
+
+/// `stamp` moved `sec` seconds and `nanosec` nanoseconds later (`nanosec` below what
+/// keeps the nanoseconds of the simulator's stamps, multiples of 10 ms, under a second).
+fn later(stamp: Time, sec: i32, nanosec: u32) -> Time {
+    Time {
+        sec: stamp.sec + sec,
+        nanosec: stamp.nanosec + nanosec,
+    }
+}
+
+#[test]
+fn outputs_carry_their_inputs_stamps_to_the_nanosecond() {
+    use crate::sim::SimEvent;
+    use std::collections::HashSet;
+    // Stamps of this decade, where f64 seconds resolve 238 ns: IMU samples at x.0025 s,
+    // every other one a nanosecond later, fixes at x.000000001 s.
+    const SEC_2025: i32 = 1_764_000_000;
+    const GPS_AND_GALILEO: u16 = NavSatStatus::SERVICE_GPS | NavSatStatus::SERVICE_GALILEO;
+    let frames = OutputFrames {
+        publish_tf: true,
+        ..OutputFrames::default()
+    };
+    let mut adapter = loose_adapter(frames);
+    let (mut imu_stamps, mut fix_stamps) = (HashSet::new(), HashSet::new());
+    let mut out = Vec::new();
+    let mut k = 0;
+    for_each_static_event_30_s(|event, stamp| match event {
+        SimEvent::Imu(s) => {
+            k += 1;
+            let stamp = later(stamp, SEC_2025, 2_500_000 + k % 2);
+            imu_stamps.insert(stamp);
+            out.extend(adapter.on_imu(&outbound::imu(&s, stamp, "imu")));
+        }
+        SimEvent::Fix(f) => {
+            let stamp = later(stamp, SEC_2025, 1);
+            fix_stamps.insert(stamp);
+            let mut fix = outbound::receiver_fix(&f, stamp, "gnss");
+            fix.status.service = GPS_AND_GALILEO;
+            out.extend(adapter.on_fix(&fix));
+        }
+        _ => {}
+    });
+    let (mut solutions, mut reports, mut no_fixes) = (0, 0, 0);
+    for published in &out {
+        match published {
+            Published::Solution(s) => {
+                let m = s.messages.as_deref().unwrap();
+                let stamp = m.odometry.header.stamp;
+                assert!(imu_stamps.contains(&stamp), "Odometry at {stamp:?}");
+                assert_eq!(m.fix.header.stamp, stamp);
+                // The fused fix names the receiver's constellations once an update used
+                // one of its fixes.
+                let service = if reports > 0 { GPS_AND_GALILEO } else { 0 };
+                assert_eq!(m.fix.status.service, service);
+                assert_eq!(m.fix.status.status, NavSatStatus::STATUS_FIX);
+                assert_eq!(m.tf.as_ref().unwrap().transforms[0].header.stamp, stamp);
+                solutions += 1;
+            }
+            Published::NoFix(f) => {
+                // Only while initializing, at a fix's stamp.
+                assert_eq!(solutions, 0, "NO_FIX after the start: {f:?}");
+                assert!(
+                    fix_stamps.contains(&f.header.stamp),
+                    "NO_FIX at {:?}",
+                    f.header
+                );
+                no_fixes += 1;
+            }
+            Published::Epoch(e) => {
+                let stamp = e.noise.header.stamp;
+                assert!(fix_stamps.contains(&stamp), "NoiseEstimates at {stamp:?}");
+                reports += 1;
+            }
+        }
+    }
+    assert!(
+        solutions > 2000 && reports > 25,
+        "{solutions} solutions, {reports} reports"
+    );
+    assert!(no_fixes > 0, "the fixes before the start say NO_FIX");
+}
+
+#[test]
+fn a_refused_solution_says_no_fix_at_its_stamp() {
+    let mut adapter = loose_adapter(OutputFrames::default());
+    let mut last = None;
+    run_static(&mut adapter, 10.0, |_, _| {});
+    // The last solution again (its IMU stamp is remembered), once with a position that is
+    // not finite and once with a negative variance.
+    for_each_static_event(10.0, |event, stamp| {
+        if let crate::sim::SimEvent::Imu(_) = event {
+            last = Some(stamp);
+        }
+    });
+    let stamp = last.unwrap();
+    let solution = adapter.engine().state().unwrap().solution();
+    let mut not_finite = solution.clone();
+    not_finite.nav.p.height_m = f64::NAN;
+    let mut negative = solution;
+    negative.covariance[(0, 0)] = -1.0;
+    for bad in [not_finite, negative] {
+        let published = adapter.publishable(vec![Output::Solution(Box::new(bad))]);
+        let [Published::NoFix(fix)] = published.as_slice() else {
+            panic!("{published:?}");
+        };
+        assert_eq!(fix.header.stamp, stamp);
+        assert_eq!(fix.status.status, NavSatStatus::STATUS_NO_FIX);
+        assert_eq!(
+            fix.position_covariance_type,
+            NavSatFix::COVARIANCE_TYPE_UNKNOWN
+        );
+        assert!(fix.latitude.is_nan());
+    }
+    let c = adapter.counts();
+    assert_eq!((c.non_finite_outputs, c.negative_variance_outputs), (1, 1));
 }

@@ -5,7 +5,7 @@
 //! (sensor_msgs/Imu), `gnss/measurements` (GnssMeasurements), `gnss/fix` (NavSatFix),
 //! `gnss/velocity` (TwistWithCovarianceStamped), `/clock` (rosgraph_msgs/Clock, for
 //! `use_sim_time`); publishes `odometry` (nav_msgs/Odometry, `map_frame` → `base_frame`),
-//! `fix` (NavSatFix), `~/noise_estimates` (NoiseEstimates), `/diagnostics`
+//! `fix/filtered` (NavSatFix), `~/noise_estimates` (NoiseEstimates), `/diagnostics`
 //! (DiagnosticArray, 1 Hz), `/rosout` (rcl_interfaces/Log) and, with `publish_tf`, `/tf`
 //! (tf2_msgs/TFMessage). Serves the parameter services ([`services`]).
 
@@ -83,6 +83,9 @@ impl Outputs {
                 Published::Epoch(epoch) => {
                     log_failure(log, self.noise.send(epoch.noise, recorder, now));
                 }
+                Published::NoFix(fix) => {
+                    log_failure(log, self.fix.send(*fix, recorder, now));
+                }
             }
         }
     }
@@ -115,7 +118,7 @@ pub fn run(
     let clock_sub = subscription::<Clock>(&mut node, &names, "/clock")?;
     let mut outputs = Outputs {
         odometry: Output::new(&mut node, &names, "odometry")?,
-        fix: Output::new(&mut node, &names, "fix")?,
+        fix: Output::new(&mut node, &names, "fix/filtered")?,
         noise: Output::new(&mut node, &names, "~/noise_estimates")?,
         tf: if params.frames.publish_tf {
             Some(Output::new(&mut node, &names, "/tf")?)
