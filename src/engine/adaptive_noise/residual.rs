@@ -257,4 +257,45 @@ mod tests {
         assert!(v.estimated);
         assert!((v.r - 4.5).abs() < 1e-12);
     }
+
+    fn fix_noise(window: usize) -> ResidualNoise {
+        let mut config = Config::default();
+        config.robust.residual_window_epochs = window;
+        ResidualNoise::new(&config)
+    }
+
+    #[test]
+    fn the_fix_covariance_estimate_stays_within_its_ceiling_over_the_nominal() {
+        let mut noise = fix_noise(2);
+        let nominal = DMatrix::from_diagonal(&DVector::from_vec(vec![0.25, 0.25, 1.0]));
+        // Residuals of 20 m on the first axis (a variance of 400 m² = 1600 nominal) that
+        // pass the learning test (their prior innovation was consistent).
+        let residual = DVector::from_vec(vec![20.0, 0.0, 0.0]);
+        let hph = DMatrix::from_diagonal_element(3, 3, 0.01);
+        for k in 0..2 {
+            noise.after_joint_update(MeasurementKind::Fix, f64::from(k), &residual, &hph, 1.0);
+        }
+        let r = noise.joint_covariance(MeasurementKind::Fix, &nominal);
+        assert!((r[(0, 0)] - JOINT_MAX_VARIANCE_RATIO * 0.25).abs() < 1e-9);
+        // The other axes keep their estimate (0.01 m², above the floor).
+        assert!((r[(2, 2)] - 0.01).abs() < 1e-9);
+    }
+
+    #[test]
+    fn an_epoch_whose_prior_innovation_fails_the_test_does_not_teach() {
+        let mut noise = fix_noise(2);
+        let nominal = DMatrix::identity(3, 3);
+        let residual = DVector::from_vec(vec![0.5, 0.5, 0.5]);
+        let hph = DMatrix::from_diagonal_element(3, 3, 0.1);
+        let threshold = chi_square_quantile(LEARN_CONFIDENCE, 3).unwrap();
+        noise.after_joint_update(MeasurementKind::Fix, 0.0, &residual, &hph, 1.0);
+        noise.after_joint_update(MeasurementKind::Fix, 1.0, &residual, &hph, threshold * 1.01);
+        assert_eq!(
+            noise.joint_covariance(MeasurementKind::Fix, &nominal),
+            nominal
+        );
+        noise.after_joint_update(MeasurementKind::Fix, 2.0, &residual, &hph, threshold);
+        let r = noise.joint_covariance(MeasurementKind::Fix, &nominal);
+        assert!((r[(0, 0)] - 0.35).abs() < 1e-9);
+    }
 }
