@@ -1,6 +1,6 @@
 //! Issue 11, item 5: every variant, loosely coupled, on a consumer-MEMS drive with a GNSS
 //! outage and a street canyon whose receiver fixes are tens to hundreds of metres off at
-//! times (tests/data/consumer_mems_drive.yaml, the six-minute cut of
+//! times (tests/data/consumer_mems_drive.yaml, the short version of
 //! tests/data/consumer_mems_hour.yaml), with the IMU noise of its class
 //! (params/imu_consumer_mems.yaml). Before the fix, residual_akf learned the filter's own
 //! drift as measurement noise after one bad fix and ran off (RMSE 181 m against the EKF's
