@@ -162,17 +162,18 @@ impl NoiseModel {
         }
     }
 
-    /// Hands over the post-update residual ε = z − H x̂ of such a measurement and its
-    /// H P̂ Hᵀ.
+    /// Hands over the post-update residual ε = z − H x̂ of such a measurement, its
+    /// H P̂ Hᵀ and the normalised innovation squared of the update's prior.
     pub fn after_joint_update(
         &mut self,
         kind: MeasurementKind,
         t_s: f64,
         residual: &DVector<f64>,
         hph: &DMatrix<f64>,
+        prior_nis: f64,
     ) {
         if let Self::Residual(m) = self {
-            m.after_joint_update(kind, t_s, residual, hph);
+            m.after_joint_update(kind, t_s, residual, hph, prior_nis);
         }
     }
 

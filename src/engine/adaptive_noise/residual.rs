@@ -16,18 +16,46 @@
 //! - Only measurements seen for the first time teach the estimators (not those re-applied
 //!   after a roll-back), and a satellite unseen for longer than `adaptive.max_epoch_gap_s`
 //!   starts a new window.
+//! - Loosely coupled (issue 11): eq. (13), E{εεᵀ} = R − H P̂ Hᵀ, holds when the prediction
+//!   error is what P⁻ says. Written with the innovation d and S = H P⁻ Hᵀ + R̂, a sample is
+//!   R̂ + R̂ S⁻¹ (d dᵀ − S) S⁻¹ R̂, i.e. d dᵀ once R̂ ≫ H P⁻ Hᵀ: an error of the prediction
+//!   that the update did not remove is learned as measurement noise, the larger R̂ lowers
+//!   the gain, the prediction error grows and R̂ with it. Measured on
+//!   tests/data/consumer_mems_hour.yaml: one street-canyon fix 134 m off raised the
+//!   vertical R̂ from 3.6 to 285 m² (one sample of 64), and the loop then carried it to
+//!   6.7e4 m² and the state 450 m away within 100 s while the receiver's fixes stayed
+//!   within tens of metres. Two departures from the paper, which is silent on both, break
+//!   the loop: an epoch whose prior innovation fails the χ² test of [`LEARN_CONFIDENCE`]
+//!   against S (an outlier, or a prediction worse than P⁻ says: either way its residual
+//!   does not measure the noise) does not teach, and R̂ is capped at
+//!   [`JOINT_MAX_VARIANCE_RATIO`] times the receiver's covariance in every direction,
+//!   the ceiling the per-satellite estimates have in `adaptive.*` (a fix 10 σ off its
+//!   receiver's model is a fault, not noise to adapt to). A noise that truly rises by
+//!   more than the test admits at once is then learned from its smaller draws only, so
+//!   more slowly; a refused epoch leaves R̂ as it was, so the filter is then at worst the
+//!   EKF of the R̂ learned before.
 
 use std::collections::hash_map::Entry;
 use std::collections::HashMap;
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{DMatrix, DVector, SymmetricEigen};
 
+use crate::adaptive::mahalanobis::chi_square_quantile;
 use crate::adaptive::residual_r::{ResidualCovarianceEstimator, ResidualCovarianceOptions};
 use crate::config::Config;
 use crate::gnss::SatId;
+use crate::linalg::symmetrize;
 
 use super::super::output::MeasurementKind;
 use super::{track_for, NoiseVerdict, Observable, ScalarMeasurement, VarianceBounds};
+
+/// Confidence of the χ² test an update's prior innovation must pass for its residual to
+/// teach the joint estimator.
+pub const LEARN_CONFIDENCE: f64 = 0.999;
+
+/// Largest ratio of the estimated to the nominal variance of a measurement whose noise is
+/// one matrix (a receiver's fix), in any direction.
+pub const JOINT_MAX_VARIANCE_RATIO: f64 = 100.0;
 
 #[derive(Debug, Clone)]
 struct Track {
@@ -114,24 +142,33 @@ impl ResidualNoise {
     }
 
     /// The covariance of a measurement of `kind` whose noise is one matrix: the window's
-    /// estimate when full and of the same dimension, else `nominal`.
+    /// estimate when full and of the same dimension, at most [`JOINT_MAX_VARIANCE_RATIO`]
+    /// times `nominal` in every direction; else `nominal`.
     pub fn joint_covariance(&self, kind: MeasurementKind, nominal: &DMatrix<f64>) -> DMatrix<f64> {
         self.joint
             .get(&kind)
             .and_then(|t| t.estimator.estimate())
             .filter(|r| r.nrows() == nominal.nrows())
+            .and_then(|r| capped_by_nominal(&r, nominal))
             .unwrap_or_else(|| nominal.clone())
     }
 
     /// Learns from the post-update residual ε = z − H x̂ of such a measurement and its
-    /// H P̂ Hᵀ.
+    /// H P̂ Hᵀ, unless the update's prior innovation fails the consistency test of
+    /// [`LEARN_CONFIDENCE`] (`prior_nis`: dᵀ S⁻¹ d with S = H P⁻ Hᵀ + R̂).
     pub fn after_joint_update(
         &mut self,
         kind: MeasurementKind,
         t_s: f64,
         residual: &DVector<f64>,
         hph: &DMatrix<f64>,
+        prior_nis: f64,
     ) {
+        let consistent = chi_square_quantile(LEARN_CONFIDENCE, residual.len())
+            .is_ok_and(|threshold| prior_nis <= threshold);
+        if !consistent {
+            return;
+        }
         let track = match self.joint.entry(kind) {
             Entry::Occupied(e) => e.into_mut(),
             Entry::Vacant(e) => {
@@ -151,6 +188,21 @@ impl ResidualNoise {
         self.tracks.clear();
         self.joint.clear();
     }
+}
+
+/// `estimate` with the eigenvalues of N^(-1/2) R̂ N^(-T/2) (N = L Lᵀ the nominal covariance)
+/// lowered to [`JOINT_MAX_VARIANCE_RATIO`]: no direction's variance exceeds that many times
+/// the nominal one. None when the nominal has no Cholesky factor or the eigen-solver fails
+/// (the caller then uses the nominal).
+fn capped_by_nominal(estimate: &DMatrix<f64>, nominal: &DMatrix<f64>) -> Option<DMatrix<f64>> {
+    let l = nominal.clone().cholesky()?.l();
+    let l_inv = l.clone().try_inverse()?;
+    let ratio = symmetrize(&(&l_inv * estimate * l_inv.transpose()));
+    let eigen = SymmetricEigen::try_new(ratio, f64::EPSILON, 10_000)?;
+    let capped = eigen.eigenvalues.map(|v| v.min(JOINT_MAX_VARIANCE_RATIO));
+    let ratio =
+        &eigen.eigenvectors * DMatrix::from_diagonal(&capped) * eigen.eigenvectors.transpose();
+    Some(symmetrize(&(&l * ratio * l.transpose())))
 }
 
 /// Pushes one sample into a track unless `t_s` was already learned; a gap longer than
@@ -204,5 +256,46 @@ mod tests {
         // ε = 2: ε² + hPh = 4.5.
         assert!(v.estimated);
         assert!((v.r - 4.5).abs() < 1e-12);
+    }
+
+    fn fix_noise(window: usize) -> ResidualNoise {
+        let mut config = Config::default();
+        config.robust.residual_window_epochs = window;
+        ResidualNoise::new(&config)
+    }
+
+    #[test]
+    fn the_fix_covariance_estimate_stays_within_its_ceiling_over_the_nominal() {
+        let mut noise = fix_noise(2);
+        let nominal = DMatrix::from_diagonal(&DVector::from_vec(vec![0.25, 0.25, 1.0]));
+        // Residuals of 20 m on the first axis (a variance of 400 m² = 1600 nominal) that
+        // pass the learning test (their prior innovation was consistent).
+        let residual = DVector::from_vec(vec![20.0, 0.0, 0.0]);
+        let hph = DMatrix::from_diagonal_element(3, 3, 0.01);
+        for k in 0..2 {
+            noise.after_joint_update(MeasurementKind::Fix, f64::from(k), &residual, &hph, 1.0);
+        }
+        let r = noise.joint_covariance(MeasurementKind::Fix, &nominal);
+        assert!((r[(0, 0)] - JOINT_MAX_VARIANCE_RATIO * 0.25).abs() < 1e-9);
+        // The other axes keep their estimate (0.01 m², above the floor).
+        assert!((r[(2, 2)] - 0.01).abs() < 1e-9);
+    }
+
+    #[test]
+    fn an_epoch_whose_prior_innovation_fails_the_test_does_not_teach() {
+        let mut noise = fix_noise(2);
+        let nominal = DMatrix::identity(3, 3);
+        let residual = DVector::from_vec(vec![0.5, 0.5, 0.5]);
+        let hph = DMatrix::from_diagonal_element(3, 3, 0.1);
+        let threshold = chi_square_quantile(LEARN_CONFIDENCE, 3).unwrap();
+        noise.after_joint_update(MeasurementKind::Fix, 0.0, &residual, &hph, 1.0);
+        noise.after_joint_update(MeasurementKind::Fix, 1.0, &residual, &hph, threshold * 1.01);
+        assert_eq!(
+            noise.joint_covariance(MeasurementKind::Fix, &nominal),
+            nominal
+        );
+        noise.after_joint_update(MeasurementKind::Fix, 2.0, &residual, &hph, threshold);
+        let r = noise.joint_covariance(MeasurementKind::Fix, &nominal);
+        assert!((r[(0, 0)] - 0.35).abs() < 1e-9);
     }
 }

@@ -186,9 +186,13 @@ impl<M: MeasurementModel> Step<'_, M> {
             let hph = &h * p * h.transpose();
             let hph = (&hph + hph.transpose()) * 0.5;
             let t_s = self.model.t_s();
-            self.adaptation
-                .noise
-                .after_joint_update(kind, t_s, &residual, &hph);
+            self.adaptation.noise.after_joint_update(
+                kind,
+                t_s,
+                &residual,
+                &hph,
+                self.report.prior_nis,
+            );
         }
         Ok(())
     }
