@@ -167,6 +167,20 @@ fn spawn(binary: &str, args: &[&str]) -> Child {
         .unwrap()
 }
 
+/// A ros2-client node of the test on the test's domain (its context must live as long).
+fn peer_node(name: &str) -> (Context, Node) {
+    let context = Context::with_options(ContextOptions::new().domain_id(DOMAIN_ID)).unwrap();
+    let node = context
+        .new_node(
+            NodeName::new("/", name).unwrap(),
+            NodeOptions::new()
+                .enable_rosout(false)
+                .start_parameter_services(false),
+        )
+        .unwrap();
+    (context, node)
+}
+
 /// The value of `key` in the status named `node` of a diagnostics array.
 fn diagnostic(d: &DiagnosticArray, node: &str, key: &str) -> Option<u64> {
     d.status
@@ -274,15 +288,7 @@ fn ubx_node_and_filter_node_give_the_replay_of_the_converted_bag() {
     );
     let mut filter_node = KillOnDrop(filter_node);
 
-    let context = Context::with_options(ContextOptions::new().domain_id(DOMAIN_ID)).unwrap();
-    let mut peer = context
-        .new_node(
-            NodeName::new("/", "ubx_player").unwrap(),
-            NodeOptions::new()
-                .enable_rosout(false)
-                .start_parameter_services(false),
-        )
-        .unwrap();
+    let (_context, mut peer) = peer_node("ubx_player");
     let rawx_pub = publisher::<UbxRxmRawx>(&mut peer, "/ubx_rxm_rawx");
     let sfrbx_pub = publisher::<UbxRxmSfrbx>(&mut peer, "/ubx_rxm_sfrbx");
     let imu_pub = publisher::<Imu>(&mut peer, "/imu/data");
@@ -523,15 +529,7 @@ fn ubx_node_memory_is_flat_over_a_ten_minute_loop() {
         env!("CARGO_BIN_EXE_gnss_ins"),
         &["play", bag.to_str().unwrap(), "--loop", "--delay", "2"],
     ));
-    let context = Context::with_options(ContextOptions::new().domain_id(DOMAIN_ID)).unwrap();
-    let mut peer = context
-        .new_node(
-            NodeName::new("/", "soak_listener").unwrap(),
-            NodeOptions::new()
-                .enable_rosout(false)
-                .start_parameter_services(false),
-        )
-        .unwrap();
+    let (_context, mut peer) = peer_node("soak_listener");
     let diag_sub = subscriber::<DiagnosticArray>(&mut peer, "/diagnostics");
     let spinner = peer.spinner().unwrap();
     std::thread::spawn(move || smol::block_on(spinner.spin()));
