@@ -39,7 +39,7 @@ use adaptive_gnss_ins::tools::convert::{
 use adaptive_gnss_ins::tools::convert_bag::{RobotBag, RobotBagTopics};
 use adaptive_gnss_ins::tools::replay::{replay, ReplayOptions, TruthSource};
 use netns_support::{reexec_in_private_netns, KillOnDrop};
-use odometry_support::{decoded, largest_difference};
+use odometry_support::{decoded, largest_difference_of_runs};
 use ros2_client::{
     Context, ContextOptions, MessageTypeName, Name, Node, NodeName, NodeOptions, Publisher,
     QosProfile, Subscription,
@@ -399,19 +399,7 @@ fn ubx_node_and_filter_node_give_the_replay_of_the_converted_bag() {
         "the filter node did not stop cleanly: {exit}"
     );
     let live: Vec<Odometry> = decoded(&recorded, "/vehicle/odometry");
-    assert_eq!(
-        live.len(),
-        offline.len(),
-        "Odometry messages: nodes vs replay"
-    );
-    let worst = live
-        .iter()
-        .zip(&offline)
-        .map(|(a, b)| {
-            assert_eq!(a.header.stamp, b.header.stamp);
-            largest_difference(a, b)
-        })
-        .fold(0.0_f64, f64::max);
+    let worst = largest_difference_of_runs(&live, &offline, "nodes vs replay");
     println!(
         "nodes vs replay of the converted bag: {} measurements, {} solutions, largest \
          difference {worst:e}",

@@ -40,3 +40,16 @@ pub fn largest_difference(a: &Odometry, b: &Odometry) -> f64 {
     .iter()
     .fold(0.0_f64, |m, d| m.max(d.abs()))
 }
+
+/// Largest [`largest_difference`] between two runs' solutions, asserting that they have
+/// the same number of solutions at the same stamps (`what` names the two runs).
+pub fn largest_difference_of_runs(live: &[Odometry], offline: &[Odometry], what: &str) -> f64 {
+    assert_eq!(live.len(), offline.len(), "Odometry messages: {what}");
+    live.iter()
+        .zip(offline)
+        .map(|(a, b)| {
+            assert_eq!(a.header.stamp, b.header.stamp, "{what}");
+            largest_difference(a, b)
+        })
+        .fold(0.0_f64, f64::max)
+}
