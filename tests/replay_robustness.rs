@@ -8,6 +8,8 @@
 //!
 //! The bags are made from the golden fixture (tests/data/fixture_small.mcap, 36 s).
 
+mod odometry_support;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -463,28 +465,6 @@ const OPEN_SCREEN_YAML: &str = "/**:\n  ros__parameters:\n    imu:\n      \
     gyro_max_step_deg_per_s: 0.0\n      accel_max_step_g: 0.0\n";
 
 /// Every number of an Odometry.
-fn odometry_values(o: &Odometry) -> Vec<f64> {
-    let (p, t) = (&o.pose.pose, &o.twist.twist);
-    let mut values = vec![
-        p.position.x,
-        p.position.y,
-        p.position.z,
-        p.orientation.x,
-        p.orientation.y,
-        p.orientation.z,
-        p.orientation.w,
-        t.linear.x,
-        t.linear.y,
-        t.linear.z,
-        t.angular.x,
-        t.angular.y,
-        t.angular.z,
-    ];
-    values.extend(o.pose.covariance);
-    values.extend(o.twist.covariance);
-    values
-}
-
 /// Issue 12, item 7: a gyro sample of 10¹⁰ rad/s every 100 samples made replay write
 /// solutions with non-finite covariances and negative variances (NaN σ in the CSV).
 /// Replay now has the node's guard: they are counted and not written, to the bag or the
@@ -550,7 +530,10 @@ fn solutions_with_a_non_finite_value_or_a_negative_variance_are_counted_and_not_
             "/odometry" => {
                 odometry += 1;
                 let o: Odometry = cdr::decode(&m.data).unwrap();
-                assert!(odometry_values(&o).iter().all(|v| v.is_finite()), "{o:?}");
+                assert!(
+                    odometry_support::numbers(&o).iter().all(|v| v.is_finite()),
+                    "{o:?}"
+                );
                 let (pose, twist) = (&o.pose.covariance, &o.twist.covariance);
                 assert!((0..6).all(|k| pose[7 * k] >= 0.0 && twist[7 * k] >= 0.0));
             }

@@ -53,3 +53,26 @@ pub fn largest_difference_of_runs(live: &[Odometry], offline: &[Odometry], what:
         })
         .fold(0.0_f64, f64::max)
 }
+
+/// Every number of an Odometry: pose, orientation, twist and both covariances.
+pub fn numbers(o: &Odometry) -> Vec<f64> {
+    let (p, t) = (&o.pose.pose, &o.twist.twist);
+    let mut values = vec![
+        p.position.x,
+        p.position.y,
+        p.position.z,
+        p.orientation.x,
+        p.orientation.y,
+        p.orientation.z,
+        p.orientation.w,
+        t.linear.x,
+        t.linear.y,
+        t.linear.z,
+        t.angular.x,
+        t.angular.y,
+        t.angular.z,
+    ];
+    values.extend(o.pose.covariance);
+    values.extend(o.twist.covariance);
+    values
+}
