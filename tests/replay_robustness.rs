@@ -374,6 +374,45 @@ fn a_bag_whose_imu_never_decodes_exits_non_zero_and_says_what_was_used() {
     assert!(text.contains("37 on /gnss/measurements"), "{text}");
 }
 
+/// Issue 12, item 9: a configuration under which the fixture never starts names the
+/// parameter that prevents the start (the fixture sees at most 10 satellites and drives
+/// at 8 m/s), not "nothing usable in the bag".
+#[test]
+fn a_configuration_that_never_starts_names_the_parameter_that_prevents_it() {
+    let dir = tempfile::tempdir().unwrap();
+    for (section, key, value, expected) in [
+        (
+            "init",
+            "min_satellites",
+            "64",
+            "init.min_satellites = 64 satellites",
+        ),
+        (
+            "init",
+            "heading_min_speed_mps",
+            "50.0",
+            "init.heading_min_speed_mps = 50 m/s",
+        ),
+    ] {
+        let params = dir.path().join(format!("{key}.yaml"));
+        std::fs::write(
+            &params,
+            format!("/**:\n  ros__parameters:\n    {section}:\n      {key}: {value}\n"),
+        )
+        .unwrap();
+        let output = gnss_ins(&[
+            "replay".as_ref(),
+            fixture_bag().as_os_str(),
+            "--params".as_ref(),
+            params.as_os_str(),
+        ]);
+        assert!(!output.status.success());
+        let text = stderr(&output);
+        assert!(text.contains("no solution"), "{text}");
+        assert!(text.contains(expected), "{key}: {text}");
+    }
+}
+
 #[test]
 fn a_file_that_is_not_a_bag_fails_with_the_reason() {
     let dir = tempfile::tempdir().unwrap();

@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use crate::config::{Config, Coupling};
-use crate::engine::{RejectionCounters, RejectionReason};
+use crate::engine::{InitPhase, RejectionCounters, RejectionReason};
 use crate::eval::ErrorSummary;
 use crate::ros::adapter::{Input, InputCounts, OutputFrames, Published, RosAdapter};
 use crate::ros::bag::{BagError, BagReader};
@@ -41,6 +41,8 @@ pub struct BagRun {
     pub unpaired_velocities: u64,
     /// The engine's rejections by reason.
     pub rejections: RejectionCounters,
+    /// Where the start-up stood at the end of the bag (None: the filter was running).
+    pub start_phase: Option<InitPhase>,
 }
 
 /// What became of the receiver velocities of a bag (counted as the node counts them).
@@ -183,6 +185,7 @@ impl BagRunner {
             counts: self.adapter.counts().clone(),
             unpaired_velocities: self.adapter.unpaired_velocities(),
             rejections: self.adapter.engine().counters().clone(),
+            start_phase: self.adapter.engine().init_phase(),
         })
     }
 }

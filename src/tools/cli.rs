@@ -20,6 +20,7 @@ use super::compare::{
 use super::plots::{write_plots, FilterRun};
 use super::replay::{self, ReplayOptions, TruthSource};
 use super::simulate::{self, TRUTH_TOPIC};
+use super::start_blocker::start_blocker;
 
 /// Scoring interval of a replay (s): every solution that has a reference.
 const SCORE_INTERVAL_S: f64 = 0.0;
@@ -218,14 +219,14 @@ pub fn run(command: Command) -> Result<(), String> {
                     .map(|(topic, n)| format!("{n} on {topic}"))
                     .collect();
                 return Err(format!(
-                    "{}: no solution, nothing usable in the bag (messages used: {}); the \
-                     engine needs IMU samples and GNSS measurements or fixes to start",
+                    "{}: no solution (messages used: {}): {}",
                     bag.display(),
                     if used.is_empty() {
                         "none".to_owned()
                     } else {
                         used.join(", ")
-                    }
+                    },
+                    start_blocker(result.start_phase, &config)
                 ));
             }
             // Choice: a replay fails when most of its IMU messages did not reach the

@@ -19,4 +19,5 @@ pub mod session;
 pub mod simulate;
 pub mod spp_rinex;
 pub mod spp_run;
+pub mod start_blocker;
 pub mod time_tag;
