@@ -234,6 +234,42 @@ fn spp_rejects_a_gross_outlier_and_keeps_the_truth() {
     assert!((dragged.pos_ecef_m - rx.pos_ecef_m).norm() > 5.0);
 }
 
+/// One wrong rate (a satellite velocity off by 3 km/s along the line of sight does
+/// this) is excluded by the same w-test; without it the velocity is off by metres per
+/// second.
+#[test]
+fn spp_rejects_a_gross_rate_outlier_and_keeps_the_true_velocity() {
+    let c = GpsConstellation::augmented(1);
+    let atmosphere = AtmosphereTruth::models(klobuchar());
+    let site = Llh::from_degrees(45.0, 10.0, 250.0);
+    let rx = truth(&site, 1);
+    let mut epoch = noise_free_epoch(&c, 3_600.0, &rx, &atmosphere);
+    let config = SppConfig::default();
+    let clean = solve_spp(&epoch, &config).unwrap();
+    let clean_velocity = clean.velocity.as_ref().unwrap();
+    assert!(clean_velocity.num_used >= 7, "{}", clean_velocity.num_used);
+    assert!(clean_velocity.outliers.is_empty());
+    let target = clean_velocity.residuals[2].0;
+    let obs = epoch
+        .satellites
+        .iter_mut()
+        .find(|o| o.sat == target)
+        .unwrap();
+    *obs.pseudorange_rate_mps.as_mut().unwrap() += 50.0;
+    let velocity = solve_spp(&epoch, &config).unwrap().velocity.unwrap();
+    assert_eq!(velocity.outliers.len(), 1);
+    assert_eq!(velocity.outliers[0].0, target);
+    assert!(velocity.outliers[0].1.abs() > 4.0);
+    assert_eq!(velocity.num_used, clean_velocity.num_used - 1);
+    assert!((velocity.vel_ecef_mps - rx.vel_ecef_mps).norm() < MAX_SPP_VEL_ERR_MPS);
+    let off = SppConfig {
+        outlier_threshold: None,
+        ..config
+    };
+    let dragged = solve_spp(&epoch, &off).unwrap().velocity.unwrap();
+    assert!((dragged.vel_ecef_mps - rx.vel_ecef_mps).norm() > 5.0);
+}
+
 #[test]
 fn spp_reports_too_few_satellites_and_missing_rates() {
     let c = GpsConstellation::augmented(1);

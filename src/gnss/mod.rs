@@ -10,6 +10,7 @@ mod observation;
 pub mod rinex_nav;
 pub mod rinex_obs;
 pub mod rinex_spp;
+pub mod satellite_bounds;
 pub mod spp;
 pub mod time_scale;
 pub mod ubx;

@@ -31,7 +31,10 @@
 //!   unknowns are 3 + the number of clocks, and the 6 becomes that plus 2.
 //! - Velocity and clock drift: linear weighted least squares on the rates of the
 //!   satellites used for the position, at the converged position (exact in one step,
-//!   the rate model being linear in the receiver velocity and drift). No outlier test.
+//!   the rate model being linear in the receiver velocity and drift), with the same
+//!   w-test and threshold on the rate residuals, one exclusion at a time while 6 rates
+//!   remain. (Without it one wrong rate, e.g. a satellite velocity off by 3 km/s, once
+//!   put the start-up's velocity, and the run, kilometres off.)
 
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix4, Vector3, Vector4};
 use thiserror::Error;
@@ -230,6 +233,8 @@ pub struct SppVelocity {
     pub residuals: Vec<(SatId, f64)>,
     /// Number of rates used.
     pub num_used: usize,
+    /// Rates excluded by the outlier test, with their standardized residual.
+    pub outliers: Vec<(SatId, f64)>,
 }
 
 /// Single-point solution of one epoch.
@@ -680,7 +685,35 @@ fn solve_velocity(
         ));
         sats.push(obs.sat);
     }
-    let (x, covariance) = solve_normal_equations(&rate_rows, UNKNOWNS)?;
+    let mut outliers = Vec::new();
+    let (x, covariance) = loop {
+        let (x, covariance) = solve_normal_equations(&rate_rows, UNKNOWNS)?;
+        let worst = config.outlier_threshold.and_then(|threshold| {
+            if rate_rows.len() < UNKNOWNS + OUTLIER_TEST_REDUNDANCY {
+                return None;
+            }
+            rate_rows
+                .iter()
+                .map(|(h, v, sigma)| {
+                    let var = sigma * sigma - (h.transpose() * &covariance * h)[0];
+                    if var > 1e-12 * sigma * sigma {
+                        (v - h.dot(&x)) / var.sqrt()
+                    } else {
+                        0.0
+                    }
+                })
+                .enumerate()
+                .filter(|(_, w)| w.abs() > threshold)
+                .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+        });
+        match worst {
+            Some((k, w)) => {
+                rate_rows.remove(k);
+                outliers.push((sats.remove(k), w));
+            }
+            None => break (x, covariance),
+        }
+    };
     let vel_ecef_mps = Vector3::new(x[0], x[1], x[2]);
     let residuals = sats
         .iter()
@@ -694,6 +727,7 @@ fn solve_velocity(
         covariance: Matrix4::from_fn(|i, j| covariance[(i, j)]),
         residuals,
         num_used: rate_rows.len(),
+        outliers,
     })
 }
 

@@ -11,6 +11,10 @@ use super::msg::{
 };
 use crate::earth::Llh;
 use crate::engine::GnssFix;
+use crate::gnss::satellite_bounds::{
+    MAX_ORBIT_RADIUS_M, MAX_SAT_CLOCK_BIAS_S, MAX_SAT_CLOCK_DRIFT_S_S, MAX_SAT_SPEED_MPS,
+    MIN_ORBIT_RADIUS_M,
+};
 use crate::gnss::{CarrierPhase, Constellation, GnssEpoch, Klobuchar, SatId, SatObservation};
 use crate::ins::ImuSample;
 
@@ -290,6 +294,46 @@ fn sat_observation(
     let check = FieldCheck { t_s, sat };
     let pos = &m.satellite_position_ecef_m;
     let vel = &m.satellite_velocity_ecef_mps;
+    let sat_pos_ecef_m = Vector3::new(
+        check.required("satellite_position_ecef_m.x", pos.x)?,
+        check.required("satellite_position_ecef_m.y", pos.y)?,
+        check.required("satellite_position_ecef_m.z", pos.z)?,
+    );
+    let sat_vel_ecef_mps = Vector3::new(
+        check.required("satellite_velocity_ecef_mps.x", vel.x)?,
+        check.required("satellite_velocity_ecef_mps.y", vel.y)?,
+        check.required("satellite_velocity_ecef_mps.z", vel.z)?,
+    );
+    let sat_clock_bias_s = check.required("satellite_clock_bias_s", m.satellite_clock_bias_s)?;
+    let sat_clock_drift_s_s =
+        check.required("satellite_clock_drift_s_s", m.satellite_clock_drift_s_s)?;
+    // Choice: a satellite state no GNSS satellite has (gnss::satellite_bounds) rejects the
+    // epoch like a non-finite one: a crafted or corrupted satellite velocity of 1e300 m/s
+    // once put the start-up's velocity, and the whole run, 1,900 km off (attack suite).
+    check.bounded(
+        "|satellite_position_ecef_m|",
+        sat_pos_ecef_m.norm(),
+        MIN_ORBIT_RADIUS_M..=MAX_ORBIT_RADIUS_M,
+        "a GNSS orbit radius, 2e7 to 5e7 m",
+    )?;
+    check.bounded(
+        "|satellite_velocity_ecef_mps|",
+        sat_vel_ecef_mps.norm(),
+        0.0..=MAX_SAT_SPEED_MPS,
+        "a GNSS satellite's speed, at most 1e4 m/s",
+    )?;
+    check.bounded(
+        "|satellite_clock_bias_s|",
+        sat_clock_bias_s.abs(),
+        0.0..=MAX_SAT_CLOCK_BIAS_S,
+        "at most 1 s",
+    )?;
+    check.bounded(
+        "|satellite_clock_drift_s_s|",
+        sat_clock_drift_s_s.abs(),
+        0.0..=MAX_SAT_CLOCK_DRIFT_S_S,
+        "at most 1e-6 s/s",
+    )?;
     Ok(SatObservation {
         sat,
         pseudorange_m: check.required("pseudorange_m", m.pseudorange_m)?,
@@ -298,19 +342,10 @@ fn sat_observation(
         pseudorange_rate_sigma_mps: check
             .sigma("pseudorange_rate_sigma_mps", m.pseudorange_rate_sigma_mps)?,
         cn0_dbhz: check.optional("cn0_dbhz", f64::from(m.cn0_dbhz))?,
-        sat_pos_ecef_m: Vector3::new(
-            check.required("satellite_position_ecef_m.x", pos.x)?,
-            check.required("satellite_position_ecef_m.y", pos.y)?,
-            check.required("satellite_position_ecef_m.z", pos.z)?,
-        ),
-        sat_vel_ecef_mps: Vector3::new(
-            check.required("satellite_velocity_ecef_mps.x", vel.x)?,
-            check.required("satellite_velocity_ecef_mps.y", vel.y)?,
-            check.required("satellite_velocity_ecef_mps.z", vel.z)?,
-        ),
-        sat_clock_bias_s: check.required("satellite_clock_bias_s", m.satellite_clock_bias_s)?,
-        sat_clock_drift_s_s: check
-            .required("satellite_clock_drift_s_s", m.satellite_clock_drift_s_s)?,
+        sat_pos_ecef_m,
+        sat_vel_ecef_mps,
+        sat_clock_bias_s,
+        sat_clock_drift_s_s,
         iono_delay_m: check.optional("ionosphere_delay_m", m.ionosphere_delay_m)?,
         tropo_delay_m: check.optional("troposphere_delay_m", m.troposphere_delay_m)?,
         carrier_phase: carrier_phase(&check, m)?,
@@ -382,6 +417,21 @@ impl FieldCheck {
             Ok(Some(value))
         } else {
             Err(self.error(field, value, "a finite number or NaN (absent)"))
+        }
+    }
+
+    /// A required value whose size must not exceed `limit` (`expected` says so).
+    fn bounded(
+        &self,
+        field: &'static str,
+        size: f64,
+        limit: std::ops::RangeInclusive<f64>,
+        expected: &'static str,
+    ) -> Result<(), ConvertError> {
+        if limit.contains(&size) {
+            Ok(())
+        } else {
+            Err(self.error(field, size, expected))
         }
     }
 
@@ -668,6 +718,44 @@ mod tests {
             field_error(&msg),
             ("G05".to_string(), "satellite_clock_bias_s")
         );
+    }
+
+    #[test]
+    fn a_satellite_state_no_gnss_satellite_has_names_the_field() {
+        let cases: [(fn(&mut SatelliteMeasurement), &str); 5] = [
+            (
+                // On the ground.
+                |s| {
+                    s.satellite_position_ecef_m = Point {
+                        x: 6.4e6,
+                        y: 0.0,
+                        z: 0.0,
+                    }
+                },
+                "|satellite_position_ecef_m|",
+            ),
+            (
+                |s| s.satellite_position_ecef_m.z = 1e300,
+                "|satellite_position_ecef_m|",
+            ),
+            (
+                |s| s.satellite_velocity_ecef_mps.z = 1e300,
+                "|satellite_velocity_ecef_mps|",
+            ),
+            (
+                |s| s.satellite_clock_bias_s = -2.0,
+                "|satellite_clock_bias_s|",
+            ),
+            (
+                |s| s.satellite_clock_drift_s_s = 1e-3,
+                "|satellite_clock_drift_s_s|",
+            ),
+        ];
+        for (corrupt, field) in cases {
+            let mut msg = epoch_msg();
+            corrupt(&mut msg.satellites[1]);
+            assert_eq!(field_error(&msg), ("G05".to_string(), field));
+        }
     }
 
     #[test]

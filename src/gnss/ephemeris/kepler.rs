@@ -15,6 +15,7 @@ use nalgebra::{Matrix3, Vector3};
 
 use super::time::GpsTime;
 use crate::earth::SPEED_OF_LIGHT_M_S;
+use crate::gnss::satellite_bounds::plausible_satellite_state;
 use crate::gnss::{Constellation, SatId};
 
 /// Kepler-equation iterations: Newton from E = M converges quadratically; 10 steps
@@ -305,11 +306,7 @@ impl KeplerianEphemeris {
         let clock_bias_s =
             self.af0_s + self.af1_s_s * dtc + self.af2_s_s2 * dtc * dtc + relativistic_s;
         let clock_drift_s_s = self.af1_s_s + 2.0 * self.af2_s_s2 * dtc + relativistic_rate;
-        let plausible = (MIN_ORBIT_RADIUS_M..=MAX_ORBIT_RADIUS_M).contains(&pos_ecef_m.norm())
-            && vel_ecef_mps.norm() <= MAX_SAT_SPEED_MPS
-            && clock_bias_s.abs() <= MAX_SAT_CLOCK_BIAS_S
-            && clock_drift_s_s.abs() <= MAX_SAT_CLOCK_DRIFT_S_S;
-        if !plausible {
+        if !plausible_satellite_state(&pos_ecef_m, &vel_ecef_mps, clock_bias_s, clock_drift_s_s) {
             return None;
         }
         Some(SatState {
@@ -334,20 +331,6 @@ impl KeplerianEphemeris {
         }
     }
 }
-
-/// Bounds on a satellite state computed from broadcast elements; outside them the
-/// elements are corrupt (a decoding error, a crafted message) and the satellite is left
-/// out instead of putting a satellite at 1e59 m into the measurements.
-///
-/// Choice: every GNSS orbit has a semi-major axis between 25,500 km (GLONASS) and
-/// 42,200 km (GEO, IGSO) and an eccentricity below 0.1, so 20,000–50,000 km holds them
-/// all; ECEF speeds stay below 5 km/s (10 km/s allowed); the ICDs' a_f0 fields reach
-/// 0.06 s at most (Galileo) and a_f1 3.7e-9 s/s (GPS), bounded here by 1 s and 1e-6.
-const MIN_ORBIT_RADIUS_M: f64 = 2.0e7;
-const MAX_ORBIT_RADIUS_M: f64 = 5.0e7;
-const MAX_SAT_SPEED_MPS: f64 = 1.0e4;
-const MAX_SAT_CLOCK_BIAS_S: f64 = 1.0;
-const MAX_SAT_CLOCK_DRIFT_S_S: f64 = 1.0e-6;
 
 /// Eccentric anomaly from the mean anomaly by Newton's method on M = E − e sin E.
 fn solve_kepler(mean_anomaly_rad: f64, e: f64) -> f64 {
