@@ -6,7 +6,9 @@
 //! - `attitude_error`: roll, pitch and yaw errors (deg);
 //! - `noise_sigma`: estimated against true pseudo-range σ (m) of a few satellites.
 //!
-//! Environment segments other than open sky (foliage, urban canyon, outage) are shaded.
+//! Environment segments other than open sky (foliage, urban canyon, outage) are shaded;
+//! for a recording, the reference's quality (RTK fixed, float, worse), each its own
+//! shade. A recording's UNIX stamps are shown as seconds since its first, named in UTC.
 //!
 //! Choice: text is drawn with DejaVu Sans (the `dejavu` crate's copy, Bitstream Vera
 //! licence: free to embed and redistribute) through plotters' pure-Rust `ab_glyph`
@@ -375,8 +377,50 @@ fn environment_color(name: &str) -> RGBColor {
         "foliage" => RGBColor(120, 200, 120),
         "urban_canyon" => RGBColor(160, 160, 200),
         "outage" => RGBColor(230, 120, 120),
-        _ => RGBColor(220, 190, 120),
+        // A real reference's quality: fixed pale, float amber, anything worse lilac.
+        "rtk_fixed" => RGBColor(170, 210, 240),
+        "rtk_float" => RGBColor(240, 180, 80),
+        _ => RGBColor(200, 150, 220),
     }
+}
+
+/// Times from this on are UNIX times (1973 on); the simulator's start near 0.
+const UNIX_TIME_FROM_S: f64 = 1e8;
+
+/// The time axis of a figure spanning `x`: the offset subtracted from every time and the
+/// axis description. UNIX times are shown as seconds since the figure's first whole
+/// second, named in UTC (a recording's stamps); smaller times as they are.
+fn time_axis(x: &Range<f64>) -> (f64, String) {
+    if x.start < UNIX_TIME_FROM_S {
+        return (0.0, "time (s)".to_owned());
+    }
+    let start_s = x.start.floor();
+    (
+        start_s,
+        format!("time since {} UTC (s)", utc_text(start_s as i64)),
+    )
+}
+
+/// `YYYY-MM-DD hh:mm:ss` of a UNIX time (days to the civil date after H. Hinnant's
+/// proleptic Gregorian algorithm).
+fn utc_text(unix_s: i64) -> String {
+    let (days, second_of_day) = (unix_s.div_euclid(86_400), unix_s.rem_euclid(86_400));
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let day_of_era = z.rem_euclid(146_097);
+    let year_of_era =
+        (day_of_era - day_of_era / 1_460 + day_of_era / 36_524 - day_of_era / 146_096) / 365;
+    let day_of_year = day_of_era - (365 * year_of_era + year_of_era / 4 - year_of_era / 100);
+    let mp = (5 * day_of_year + 2) / 153;
+    let day = day_of_year - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = year_of_era + era * 400 + i64::from(month <= 2);
+    format!(
+        "{year:04}-{month:02}-{day:02} {:02}:{:02}:{:02}",
+        second_of_day / 3_600,
+        second_of_day % 3_600 / 60,
+        second_of_day % 60
+    )
 }
 
 fn draw_figure<DB: DrawingBackend>(
@@ -393,6 +437,8 @@ fn draw_figure<DB: DrawingBackend>(
     draw_legend(&legend_area, &legend_entries(figure, spans)).map_err(|e| text(&e))?;
     let panels = area.split_evenly((figure.panels.len(), 1));
     let x = x_range(figure);
+    let (t0_s, x_description) = time_axis(&x);
+    let x = (x.start - t0_s)..(x.end - t0_s);
     for (k, (panel, region)) in figure.panels.iter().zip(&panels).enumerate() {
         let y = y_range(panel);
         let mut chart = ChartBuilder::on(region)
@@ -411,14 +457,14 @@ fn draw_figure<DB: DrawingBackend>(
             .axis_desc_style((FONT, 18))
             .light_line_style(WHITE.mix(0.0));
         if k + 1 == figure.panels.len() {
-            mesh.x_desc("time (s)");
+            mesh.x_desc(&x_description);
         }
         mesh.draw().map_err(|e| text(&e))?;
         for span in spans {
             let color = environment_color(&span.name);
             chart
                 .draw_series(std::iter::once(Rectangle::new(
-                    [(span.start_s, y.start), (span.end_s, y.end)],
+                    [(span.start_s - t0_s, y.start), (span.end_s - t0_s, y.end)],
                     color.mix(SHADE_ALPHA).filled(),
                 )))
                 .map_err(|e| text(&e))?;
@@ -426,7 +472,7 @@ fn draw_figure<DB: DrawingBackend>(
         for line in &panel.lines {
             let style = ShapeStyle::from(&line.color).stroke_width(2);
             for run in split_at_gaps(&line.points) {
-                let points = run.iter().copied();
+                let points = run.iter().map(|&(t_s, v)| (t_s - t0_s, v));
                 if line.dashed {
                     chart.draw_series(DashedLineSeries::new(points, 8, 5, style))
                 } else {
@@ -577,6 +623,36 @@ mod tests {
             attitude_rpy_rad: None,
             nees: 1.0,
             nees_dof: 3,
+        }
+    }
+
+    #[test]
+    fn unix_times_are_shown_from_the_first_second_named_in_utc() {
+        let (t0_s, text) = time_axis(&(1_756_315_800.25..1_756_316_400.0));
+        assert_eq!(t0_s, 1_756_315_800.0);
+        assert_eq!(text, "time since 2025-08-27 17:30:00 UTC (s)");
+        assert_eq!(utc_text(0), "1970-01-01 00:00:00");
+        assert_eq!(utc_text(951_825_599), "2000-02-29 11:59:59");
+        assert_eq!(utc_text(4_107_542_400), "2100-03-01 00:00:00");
+        assert_eq!(
+            time_axis(&(10_800.0..10_836.0)),
+            (0.0, "time (s)".to_owned())
+        );
+    }
+
+    #[test]
+    fn rtk_fixed_float_and_worse_have_their_own_shades() {
+        let colors = [
+            "rtk_fixed",
+            "rtk_float",
+            "q5",
+            "foliage",
+            "urban_canyon",
+            "outage",
+        ]
+        .map(environment_color);
+        for (i, a) in colors.iter().enumerate() {
+            assert!(colors[i + 1..].iter().all(|b| b != a), "{colors:?}");
         }
     }
 
