@@ -6,7 +6,7 @@
 //!   (constraints.platform car) the horizontal error at the outage's end stays within 1 %
 //!   of the distance travelled in it; free inertial it is tens of metres;
 //! - a car parked without GNSS (tests/data/consumer_mems_parked.yaml, 120 s here, 600 s
-//!   by hand with `cargo test --release --test motion_constraints -- --ignored`): with
+//!   by hand with `cargo test --test motion_constraints -- --ignored`): with
 //!   the zero-velocity and zero-angular-rate updates (constraints.zupt) the position
 //!   drifts less than 0.5 m and the heading less than 1 deg; without, the position runs
 //!   off;
@@ -156,7 +156,7 @@ fn zero_velocity_and_rate_hold_a_parked_car() {
 
 /// Issue 14's ten minutes (docs/results.md).
 #[test]
-#[ignore = "ten simulated minutes parked: run by hand in release"]
+#[ignore = "ten simulated minutes parked: run by hand"]
 fn zero_velocity_and_rate_hold_a_car_parked_ten_minutes() {
     assert_parked(600.0);
 }
