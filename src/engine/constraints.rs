@@ -171,15 +171,12 @@ impl Constraints {
     /// window's mean raw rate at rest, None when moving.
     fn at_rest(&self, state: &FilterState, c: &ConstraintsConfig) -> Option<Vector3<f64>> {
         let t_s = state.last_imu.t_s;
-        let Some(mean_w) = self
+        let mean_w = self
             .windows
             .iter()
             .rev()
             .find(|(t, _)| *t == t_s)
-            .and_then(|(_, mean_w)| *mean_w)
-        else {
-            return None;
-        };
+            .and_then(|(_, mean_w)| *mean_w)?;
         let earth_b = state
             .nav
             .q_nb
