@@ -93,8 +93,8 @@ impl Constraints {
     }
 
     /// Applies the constraints due at `state`'s last sample (the one before was at
-    /// `prev_t_s`); `count` says whether they are counted. On a filter failure the state is
-    /// restored and the error returned.
+    /// `prev_t_s`); `count` says whether they are counted. On a filter failure or a
+    /// non-finite result the state is left as it was and the error returned.
     pub fn apply(
         &mut self,
         state: &mut FilterState,
@@ -109,21 +109,40 @@ impl Constraints {
         if !(c.zupt || c.platform.is_wheeled()) || !crosses(1.0 / c.rate_hz) {
             return Ok(());
         }
-        let before = state.clone();
-        let result = self.apply_due(state, crosses(WINDOW_S), config, adaptation, count);
-        if result.is_err() || !state.is_finite() {
-            *state = before;
+        let mut updated = state.clone();
+        let mut updates = self.updates;
+        let result = self
+            .update(
+                &mut updated,
+                crosses(WINDOW_S),
+                config,
+                adaptation,
+                &mut updates,
+            )
+            .and_then(|()| {
+                updated
+                    .is_finite()
+                    .then_some(())
+                    .ok_or(FilterError::NonFinite)
+            });
+        if result.is_ok() {
+            *state = updated;
+            if count {
+                self.updates = updates;
+            }
         }
         result
     }
 
-    fn apply_due(
-        &mut self,
+    /// The updates due: ZUPT (and ZARU when `zaru_due`) at rest, else NHC for a wheeled
+    /// platform that does not turn hard; each counted in `updates`.
+    fn update(
+        &self,
         state: &mut FilterState,
         zaru_due: bool,
         config: &Config,
         adaptation: &mut Adaptation,
-        count: bool,
+        updates: &mut ConstraintUpdates,
     ) -> Result<(), FilterError> {
         let c = &config.constraints;
         let t_s = state.last_imu.t_s;
@@ -134,9 +153,7 @@ impl Constraints {
                 sigma_mps: c.zupt_sigma_mps,
             };
             update::apply(state, &mut zupt, adaptation, false)?;
-            if count {
-                self.updates.zero_velocity += 1;
-            }
+            updates.zero_velocity += 1;
             if zaru_due {
                 let white_rad_s = config.imu.gyro_arw_rad_per_sqrt_s / WINDOW_S.sqrt();
                 let mut zaru = ZeroRate {
@@ -145,9 +162,7 @@ impl Constraints {
                     sigma_rad_s: white_rad_s.hypot(c.zaru_sigma_rad_s),
                 };
                 update::apply(state, &mut zaru, adaptation, false)?;
-                if count {
-                    self.updates.zero_rate += 1;
-                }
+                updates.zero_rate += 1;
             }
         } else if c.platform.is_wheeled() {
             let yaw_rate = state.compensate(&state.last_imu).w_ib_b_rad_s.z;
@@ -159,9 +174,7 @@ impl Constraints {
                     sigma_vertical_mps: c.nhc_sigma_vertical_mps,
                 };
                 update::apply(state, &mut nhc, adaptation, false)?;
-                if count {
-                    self.updates.non_holonomic += 1;
-                }
+                updates.non_holonomic += 1;
             }
         }
         Ok(())
