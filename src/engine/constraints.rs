@@ -17,8 +17,9 @@
 //!   sensor's noise: the noise strategies and the process-noise scaling do not learn from
 //!   them (the update's `learn` is false), and they give no epoch report.
 //! - ZARU measures the mean rate of the standstill test's window, compensated with the
-//!   bias estimate, once per window ([`WINDOW_S`], at the samples whose stamp crosses a
-//!   multiple of it), so that no sample is used twice; its σ adds the gyro's white noise
+//!   bias estimate, once per window ([`WINDOW_S`], at the constraint samples whose stamp
+//!   also crosses a multiple of it: every second for a rate_hz that is a whole number),
+//!   so that no sample is used twice; its σ adds the gyro's white noise
 //!   over the window to `constraints.zaru_sigma_deg_per_s`.
 //! - The yaw rate of the hard-turn test is the compensated rate about the body z axis.
 //! - Counted once, when first applied (not again when re-applied after a roll-back).
