@@ -70,6 +70,20 @@ const EVERY_KEY_CHANGED: &str = "
     mounting:
       imu_rotation_rpy_deg: [1.5, -2.25, 179.0]
       antenna_lever_arm_m: [0.31, -0.12, 1.07]
+      constraint_point_lever_arm_m: [-1.2, 0.0, -0.4]
+    constraints:
+      zupt: true
+      rate_hz: 20.0
+      zupt_sigma_mps: 0.05
+      zaru_sigma_deg_per_s: 0.01
+      rest_accel_spread_max_mg: 15.0
+      rest_gyro_spread_max_deg_per_s: 0.3
+      rest_rate_max_deg_per_s: 0.2
+      rest_gnss_speed_max_mps: 0.5
+      platform: car
+      nhc_sigma_lateral_mps: 0.2
+      nhc_sigma_vertical_mps: 0.3
+      nhc_yaw_rate_max_deg_per_s: 45.0
     clock:
       bias_noise_m_per_sqrt_s: 0.7
       drift_noise_mps_per_sqrt_s: 0.03

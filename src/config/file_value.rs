@@ -6,7 +6,9 @@ use serde::Deserialize;
 use serde_yaml::Value;
 
 use super::spec::{Kind, OutOfRange, Range};
-use super::{AdaptiveFactorKind, Coupling, EquivalentWeightKind, FilterBase, FilterVariant};
+use super::{
+    AdaptiveFactorKind, Coupling, EquivalentWeightKind, FilterBase, FilterVariant, Platform,
+};
 use crate::adaptive::burg::OrderCriterion;
 use crate::gnss::Constellation;
 
@@ -116,7 +118,8 @@ named_values!(
     AdaptiveFactorKind,
     EquivalentWeightKind,
     OrderCriterion,
-    ConstellationName
+    ConstellationName,
+    Platform
 );
 
 /// Constellation names as written in the parameter file (a local mapping, so the GNSS

@@ -40,10 +40,10 @@ pub use convert::{
 pub use error::ConfigError;
 pub use param_file::{NodeParameters, MAX_FILE_BYTES};
 pub use parameters::{
-    AdaptiveConfig, ClockConfig, Config, EngineConfig, FilterConfig, GnssConfig, ImuConfig,
-    InitConfig, LooseConfig, MountingConfig, OutputConfig, RobustConfig,
+    AdaptiveConfig, ClockConfig, Config, ConstraintsConfig, EngineConfig, FilterConfig, GnssConfig,
+    ImuConfig, InitConfig, LooseConfig, MountingConfig, OutputConfig, RobustConfig,
 };
-pub use sections::{AdaptiveFactorKind, Coupling, EquivalentWeightKind};
+pub use sections::{AdaptiveFactorKind, Coupling, EquivalentWeightKind, Platform};
 pub use spec::{Interval, Kind, Range};
 pub use table::{yaml_text, Parameter};
 pub use variant::{

@@ -18,7 +18,9 @@ use super::convert::{
 use super::file_value::ConstellationName;
 use super::spec::{Interval, Range};
 use super::table::parameter_table;
-use super::{AdaptiveFactorKind, Coupling, EquivalentWeightKind, FilterBase, FilterVariant};
+use super::{
+    AdaptiveFactorKind, Coupling, EquivalentWeightKind, FilterBase, FilterVariant, Platform,
+};
 use crate::adaptive::burg::OrderCriterion;
 use crate::earth::Llh;
 use crate::gnss::Constellation;
@@ -139,6 +141,73 @@ parameter_table! {
         lever_arm_b_m: Vector3<f64> ["antenna_lever_arm_m": [f64; 3]] = [0.0, 0.0, 0.0],
             unit "m", range Range::Within(Interval::closed(-100.0, 100.0)), at_start,
             si ToVector;
+        /// Point of the vehicle whose lateral and vertical velocity the non-holonomic
+        /// constraint holds at zero (constraints.platform car or robot: the middle of the
+        /// rear axle, or of the wheels of a differential drive), relative to the IMU, in
+        /// the body frame [forward, left, up]. The body frame is the vehicle's (x
+        /// forward): imu_rotation_rpy_deg turns the IMU into it.
+        // Choice: a point of its own, not the antenna's lever arm: the antenna sits on the
+        // roof, the point that does not slip sideways is on the ground between the wheels.
+        constraint_point_b_m: Vector3<f64> ["constraint_point_lever_arm_m": [f64; 3]]
+            = [0.0, 0.0, 0.0],
+            unit "m", range Range::Within(Interval::closed(-100.0, 100.0)), at_start,
+            si ToVector;
+    }
+
+    /// Constraints of the vehicle's motion applied as measurements at
+    /// constraints.rate_hz: zero velocity and zero angular rate at a standstill (ZUPT,
+    /// ZARU), and the non-holonomic constraint of a wheeled vehicle (NHC). All are off by
+    /// default; the IMU-class presets (params/imu_*.yaml) set the standstill thresholds
+    /// of their class.
+    section constraints: ConstraintsConfig {
+        /// Zero-velocity and zero-angular-rate updates while the IMU's last second is at
+        /// rest (the spreads and the bias-compensated mean rate below) and the receiver's
+        /// speed, when a fix gives one, does not say it moves.
+        zupt: bool = false, unit "", range ANY, at_start;
+        /// Rate of the constraint updates (ZUPT, ZARU, NHC); the IMU samples whose stamp
+        /// crosses a multiple of 1 / rate_hz carry them.
+        rate_hz: f64 = 10.0,
+            unit "Hz", range Range::Within(Interval::closed(0.01, 1e3)), at_start;
+        /// 1-sigma of each velocity component at rest (the vehicle rocking on its
+        /// suspension).
+        zupt_sigma_mps: f64 = 0.02, unit "m/s", range SIGMA, at_start;
+        /// 1-sigma of each axis of the mean angular rate over a second at rest, beyond the
+        /// gyro's white noise over that second (imu.gyro_arw_deg_per_sqrt_h), which is
+        /// added: a parked vehicle's sway and what its idle leaves in the mean.
+        zaru_sigma_rad_s: f64 ["zaru_sigma_deg_per_s": f64] = 0.005,
+            unit "deg/s", range SIGMA, at_start, si Scale::to("rad/s", RAD_PER_DEG);
+        /// Largest spread (root mean square over the axes of each axis's standard
+        /// deviation over the last second) of the specific force at rest.
+        rest_accel_spread_max_m_s2: f64 ["rest_accel_spread_max_mg": f64] = 10.0,
+            unit "mg", range SIGMA, at_start,
+            si Scale::to("m/s^2", STANDARD_GRAVITY_M_S2 / 1000.0);
+        /// Largest spread of the angular rate at rest (as rest_accel_spread_max_mg).
+        rest_gyro_spread_max_rad_s: f64 ["rest_gyro_spread_max_deg_per_s": f64] = 0.2,
+            unit "deg/s", range SIGMA, at_start, si Scale::to("rad/s", RAD_PER_DEG);
+        /// Largest norm of the mean angular rate over the last second at rest, after the
+        /// estimated gyro bias and the earth rate are removed (a slow steady turn has a
+        /// steady rate).
+        rest_rate_max_rad_s: f64 ["rest_rate_max_deg_per_s": f64] = 0.1,
+            unit "deg/s", range SIGMA, at_start, si Scale::to("rad/s", RAD_PER_DEG);
+        /// A receiver fix velocity faster than this in the last 2 s vetoes a rest (loose
+        /// coupling; in tight coupling the pseudo-range rates themselves outweigh a false
+        /// rest).
+        rest_gnss_speed_max_mps: f64 = 0.3, unit "m/s", range SIGMA, at_start;
+        /// The vehicle (enum): car or robot = a wheeled ground vehicle, whose
+        /// constraint point (mounting.constraint_point_lever_arm_m) moves neither sideways
+        /// nor up or down in the body frame (NHC); pedestrian or none = no such
+        /// constraint.
+        platform: Platform = Platform::None, unit "", range ANY, at_start;
+        /// 1-sigma of the constraint point's lateral velocity (wheel slip, a loose
+        /// mounting).
+        nhc_sigma_lateral_mps: f64 = 0.1, unit "m/s", range SIGMA, at_start;
+        /// 1-sigma of the constraint point's vertical velocity (suspension, bumps).
+        nhc_sigma_vertical_mps: f64 = 0.1, unit "m/s", range SIGMA, at_start;
+        /// The NHC is suspended while the bias-compensated yaw rate exceeds this (a hard
+        /// turn, where the tyres slip sideways).
+        nhc_yaw_rate_max_rad_s: f64 ["nhc_yaw_rate_max_deg_per_s": f64] = 30.0,
+            unit "deg/s", range Range::Within(Interval::above(0.0, 1e4)), at_start,
+            si Scale::to("rad/s", RAD_PER_DEG);
     }
 
     /// Receiver clock model: bias c*dt_u (m) and drift c*dt_ru (m/s). The defaults are a

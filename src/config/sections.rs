@@ -62,3 +62,35 @@ impl Coupling {
         }
     }
 }
+
+/// The vehicle carrying the IMU (`constraints.platform`): whether the non-holonomic
+/// constraint applies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Platform {
+    /// `car`: a wheeled road vehicle (NHC on).
+    Car,
+    /// `robot`: a wheeled ground robot (NHC on).
+    Robot,
+    /// `pedestrian`: carried by a walker (no NHC: a person steps sideways).
+    Pedestrian,
+    /// `none`: nothing known of the vehicle (no NHC).
+    None,
+}
+
+impl Platform {
+    /// The name used in the parameter file.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Car => "car",
+            Self::Robot => "robot",
+            Self::Pedestrian => "pedestrian",
+            Self::None => "none",
+        }
+    }
+
+    /// True for a wheeled vehicle, whose constraint point does not slip sideways.
+    pub fn is_wheeled(self) -> bool {
+        matches!(self, Self::Car | Self::Robot)
+    }
+}

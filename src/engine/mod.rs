@@ -29,6 +29,7 @@
 
 mod adaptation;
 pub mod adaptive_noise;
+mod constraints;
 mod filter_state;
 mod fix_track;
 pub mod heading_bank;
@@ -49,11 +50,13 @@ use crate::filter::process_model::ProcessNoise;
 use crate::gnss::GnssEpoch;
 use crate::ins::ImuSample;
 
+use constraints::Constraints;
 use heading_bank::HeadingBank;
 use imu_screen::{ImuScreen, Screened};
 use standstill::StandstillDetector;
 
 pub use adaptation::Adaptation;
+pub use constraints::ConstraintUpdates;
 pub use filter_state::{interpolate, FilterState};
 pub use initializer::{InitPhase, Initializer};
 pub use output::{
@@ -155,6 +158,8 @@ pub struct Engine {
     screen: ImuScreen,
     /// The recent body-frame samples, for the start-up's tests of rest and motion.
     standstill: StandstillDetector,
+    /// The constraints of the vehicle's motion (`constraints.*`).
+    constraints: Constraints,
 }
 
 impl Engine {
@@ -173,6 +178,7 @@ impl Engine {
             counters: RejectionCounters::default(),
             replaying: false,
             screen: ImuScreen::default(),
+            constraints: Constraints::default(),
         }
     }
 
@@ -183,6 +189,11 @@ impl Engine {
     /// Inputs rejected so far, by reason.
     pub fn counters(&self) -> &RejectionCounters {
         &self.counters
+    }
+
+    /// The constraint updates applied so far (ZUPT, ZARU, NHC).
+    pub fn constraint_updates(&self) -> ConstraintUpdates {
+        self.constraints.updates()
     }
 
     /// The running filter state, or None while initializing.
@@ -243,6 +254,7 @@ impl Engine {
         self.imu.clear();
         self.history.clear();
         self.pending.clear();
+        self.constraints.clear();
         self.last_output_t_s = f64::NEG_INFINITY;
         Output::Status(StatusEvent::Reset { t_s, reason })
     }
@@ -294,12 +306,17 @@ impl Engine {
             }
         }
         self.standstill.push(&body);
+        self.constraints
+            .push_window(body.t_s, &self.standstill, &self.config);
         self.imu.push_back(body);
         let horizon = body.t_s - self.config.engine.imu_buffer_s;
         while self.imu.len() > MAX_BUFFERED_IMU_SAMPLES
             || self.imu.front().is_some_and(|s| s.t_s < horizon) && self.imu.len() > 2
         {
             self.imu.pop_front();
+        }
+        if let Some(oldest) = self.imu.front() {
+            self.constraints.forget_before(oldest.t_s);
         }
         // Room for the state after this sample.
         while self.history.len() >= MAX_BUFFERED_IMU_SAMPLES
@@ -474,6 +491,7 @@ impl Engine {
             }
             Phase::Running(state) => {
                 if state.last_imu.t_s < s.t_s {
+                    let prev_t_s = state.last_imu.t_s;
                     let noise = self.process_noise.scaled(self.adaptation.q.scale());
                     if let Err(e) = state.propagate(s, &noise) {
                         log::warn!("IMU step to t = {:.6} s failed: {e}", s.t_s);
@@ -481,6 +499,18 @@ impl Engine {
                         let reset = self.reset(s.t_s, ResetReason::Diverged);
                         out.push(reset);
                         return;
+                    }
+                    let count = !self.replaying;
+                    let applied = self.constraints.apply(
+                        state,
+                        prev_t_s,
+                        &self.config,
+                        &mut self.adaptation,
+                        count,
+                    );
+                    if let Err(e) = applied {
+                        log::warn!("constraint update at t = {:.6} s failed: {e}", s.t_s);
+                        self.counters.reject(RejectionReason::UpdateFailed, s.t_s);
                     }
                 }
                 let state = state.as_ref().clone();
@@ -495,6 +525,9 @@ impl Engine {
     fn apply_measurement(&mut self, p: &Pending, next: &ImuSample, out: &mut Vec<Output>) {
         let t = p.measurement.t_s();
         let report = !p.reported;
+        if let Measurement::Fix(f) = &p.measurement {
+            self.constraints.note_fix(f);
+        }
         match &mut self.phase {
             Phase::Initializing(_) => self.try_start(&p.measurement, next, report, out),
             Phase::Aligning(_) => self.update_bank(&p.measurement, next, report, out),

@@ -149,6 +149,12 @@ pub enum MeasurementKind {
     Pseudoranges,
     /// A position (and optional velocity) fix (loosely coupled).
     Fix,
+    /// Zero velocity at a standstill (ZUPT).
+    ZeroVelocity,
+    /// Zero angular rate (the earth's only) at a standstill (ZARU).
+    ZeroRate,
+    /// No lateral or vertical velocity of a wheeled vehicle (NHC).
+    NonHolonomic,
 }
 
 /// The diagnostics of one measurement update.

@@ -12,12 +12,16 @@
 //! window's sample rate) together with a parked vehicle's idle ([`IDLE_ACCEL_M_S2`],
 //! [`IDLE_GYRO_RAD_S`]); the mean rate three times the turn-on gyro bias
 //! (`imu.gyro_bias_deg_per_h`), at least [`REST_RATE_FLOOR_RAD_S`].
+//!
+//! Once the filter runs, the zero-velocity update (`constraints.zupt`) asks the same
+//! window with thresholds of its own (`constraints.rest_*`, set per IMU class by the
+//! presets): then the gyro bias is estimated, and the mean rate is tested with it removed.
 
 use std::collections::VecDeque;
 
 use nalgebra::Vector3;
 
-use crate::config::ImuConfig;
+use crate::config::{ConstraintsConfig, ImuConfig};
 use crate::ins::ImuSample;
 
 /// Length of the detector's window (s). Choice: 1 s, many periods of a vehicle's
@@ -104,22 +108,43 @@ impl MotionStatistics {
         (var / 3.0).sqrt()
     }
 
+    /// The samples' rate (Hz); None for fewer than two samples or no time between them.
+    fn rate_hz(&self) -> Option<f64> {
+        (self.count >= 2 && self.last_t_s > self.first_t_s)
+            .then(|| (self.count - 1) as f64 / (self.last_t_s - self.first_t_s))
+    }
+
+    /// True when the spreads of the specific force and of the angular rate stay within
+    /// `accel_spread_max_m_s2` and `gyro_spread_max_rad_s`.
+    fn quiet(&self, accel_spread_max_m_s2: f64, gyro_spread_max_rad_s: f64) -> bool {
+        Self::spread(&self.sum_f, &self.sum_ff, self.count) <= accel_spread_max_m_s2
+            && Self::spread(&self.sum_w, &self.sum_ww, self.count) <= gyro_spread_max_rad_s
+    }
+
     /// The IMU's verdict: at rest when the samples' spreads and the mean rate stay within
     /// the thresholds that `imu` gives (see the module documentation). False for fewer
     /// than two samples.
     pub fn at_rest(&self, imu: &ImuConfig) -> bool {
-        if self.count < 2 || self.last_t_s <= self.first_t_s {
+        let Some(rate_hz) = self.rate_hz() else {
             return false;
-        }
-        let rate_hz = (self.count - 1) as f64 / (self.last_t_s - self.first_t_s);
+        };
         let accel_noise = imu.accel_vrw_m_s_per_sqrt_s * rate_hz.sqrt();
         let gyro_noise = imu.gyro_arw_rad_per_sqrt_s * rate_hz.sqrt();
         let rate_max = (3.0 * imu.gyro_bias_sigma_rad_s).max(REST_RATE_FLOOR_RAD_S);
-        Self::spread(&self.sum_f, &self.sum_ff, self.count)
-            <= (3.0 * accel_noise).hypot(IDLE_ACCEL_M_S2)
-            && Self::spread(&self.sum_w, &self.sum_ww, self.count)
-                <= (3.0 * gyro_noise).hypot(IDLE_GYRO_RAD_S)
-            && self.mean_w().norm() <= rate_max
+        self.quiet(
+            (3.0 * accel_noise).hypot(IDLE_ACCEL_M_S2),
+            (3.0 * gyro_noise).hypot(IDLE_GYRO_RAD_S),
+        ) && self.mean_w().norm() <= rate_max
+    }
+
+    /// The running filter's test of rest, with the thresholds of `constraints.*`: the
+    /// mean raw rate when the spreads stay within `rest_accel_spread_max_mg` and
+    /// `rest_gyro_spread_max_deg_per_s` (the caller compares it, bias removed, with
+    /// `rest_rate_max_deg_per_s`); None when they do not, or for fewer than two samples.
+    pub fn quiet_mean_rate(&self, c: &ConstraintsConfig) -> Option<Vector3<f64>> {
+        self.rate_hz()?;
+        self.quiet(c.rest_accel_spread_max_m_s2, c.rest_gyro_spread_max_rad_s)
+            .then(|| self.mean_w())
     }
 }
 

@@ -15,8 +15,10 @@
 //!
 //! Nothing learns from a measurement re-applied after a roll-back (`learn` false).
 //!
-//! Models: [`Pseudoranges`] (tightly coupled: pseudo-ranges and rates of a GNSS epoch) and
-//! [`FixMeasurement`] (loosely coupled: a receiver's position and velocity fix).
+//! Models: [`Pseudoranges`] (tightly coupled: pseudo-ranges and rates of a GNSS epoch),
+//! [`FixMeasurement`] (loosely coupled: a receiver's position and velocity fix), and the
+//! constraints of the vehicle's motion (`super::constraints`): [`ZeroVelocity`],
+//! [`ZeroRate`] at a standstill and [`NonHolonomic`] for a wheeled vehicle.
 //!
 //! Adding a model (zero velocity, non-holonomic constraint, wheel speed, time-differenced
 //! carrier phase, ...): a file here with a type that borrows the measurement and the
@@ -27,15 +29,18 @@
 //! [`NominalNoise::PerRow`] with a channel (satellite, observable) per row for
 //! per-satellite scalars, which are also gated; its `predict` predicts chosen rows from any
 //! state. The engine feeds it with one arm of `Engine::apply_measurement`:
-//! `update::apply(state, &mut model, adaptation, learn)`. `tests.rs` holds a zero-velocity
-//! model written this way.
+//! `update::apply(state, &mut model, adaptation, learn)`. `tests.rs` runs the
+//! zero-velocity model through every base and scheme.
 
 mod fix;
 mod gate;
 mod model;
+mod non_holonomic;
 mod pseudoranges;
 #[cfg(test)]
 mod tests;
+mod zero_rate;
+mod zero_velocity;
 
 use nalgebra::{DMatrix, DVector};
 
@@ -53,7 +58,10 @@ use gate::{gate, GateRow};
 pub(crate) use fix::{position_covariance, velocity_covariance};
 pub use fix::{FixMeasurement, GnssFix};
 pub use model::{Linearization, MeasurementModel, NoiseChannel, NominalNoise};
+pub use non_holonomic::NonHolonomic;
 pub use pseudoranges::{sigma_model, Pseudoranges};
+pub use zero_rate::ZeroRate;
+pub use zero_velocity::ZeroVelocity;
 
 /// Updates `state` with the measurement of `model`; `adaptation` gives the variances and
 /// the update and learns from the measurement unless `learn` is false. Returns the report;

@@ -1,54 +1,38 @@
-//! The shared step with a model of its own: a zero-velocity measurement written the way
-//! the recipe in the module documentation says (rows, prediction, nominal noise, report).
+//! The shared step with the zero-velocity model, wrapped so that it reports the robust
+//! weights, through every base and scheme; and the rows of H of the motion constraints
+//! against differences of their predictions.
 
-use nalgebra::{DMatrix, DVector, UnitQuaternion, Vector3};
+use nalgebra::{DVector, UnitQuaternion, Vector3};
 
 use crate::config::{Config, FilterVariant};
 use crate::earth::Llh;
-use crate::filter::measurement_rows::Row;
 use crate::filter::robust_update::UpdateOutcome;
-use crate::ins::error_state::{StateMatrix, DV};
+use crate::ins::error_state::{StateMatrix, StateVector, DV, N};
 use crate::ins::{ImuSample, NavState};
 
 use super::super::adaptation::Adaptation;
 use super::super::filter_state::FilterState;
 use super::super::output::{EpochReport, MeasurementKind};
-use super::{apply, Linearization, MeasurementModel, NominalNoise};
+use super::{apply, Linearization, MeasurementModel, NonHolonomic, ZeroRate, ZeroVelocity};
 
-/// The body is at rest: the ENU velocity is zero, with σ `sigma_mps` per axis.
-struct ZeroVelocity {
-    t_s: f64,
-    sigma_mps: f64,
-}
+/// The zero-velocity model, reporting the robust weights in the fix's field.
+struct Reported(ZeroVelocity);
 
-impl MeasurementModel for ZeroVelocity {
+impl MeasurementModel for Reported {
     fn t_s(&self) -> f64 {
-        self.t_s
+        self.0.t_s()
     }
 
     fn kind(&self) -> MeasurementKind {
-        // Choice: a test model borrows the kind whose report fields it fills.
-        MeasurementKind::Fix
+        self.0.kind()
     }
 
-    fn linearize(&mut self, state: &mut FilterState, _report: &mut EpochReport) -> Linearization {
-        let rows = (0..3)
-            .map(|i| {
-                let mut row = Row::zeros();
-                row[DV + i] = 1.0;
-                row
-            })
-            .collect();
-        Linearization {
-            rows,
-            measured: vec![0.0; 3],
-            predicted: state.nav.v_n.iter().copied().collect(),
-            noise: NominalNoise::Joint(DMatrix::identity(3, 3) * self.sigma_mps.powi(2)),
-        }
+    fn linearize(&mut self, state: &mut FilterState, report: &mut EpochReport) -> Linearization {
+        self.0.linearize(state, report)
     }
 
     fn predict(&self, state: &FilterState, rows: &[usize]) -> DVector<f64> {
-        DVector::from_iterator(rows.len(), rows.iter().map(|&i| state.nav.v_n[i]))
+        self.0.predict(state, rows)
     }
 
     fn report_update(&self, report: &mut EpochReport, _rows: &[usize], outcome: &UpdateOutcome) {
@@ -85,10 +69,10 @@ fn run(variant: FilterVariant) -> (FilterState, EpochReport) {
     config.filter.variant = variant;
     let mut adaptation = Adaptation::new(&config);
     let mut state = moving_state(1e-2);
-    let mut model = ZeroVelocity {
+    let mut model = Reported(ZeroVelocity {
         t_s: 1.0,
         sigma_mps: 0.01,
-    };
+    });
     let report = apply(&mut state, &mut model, &mut adaptation, true).unwrap();
     (state, report)
 }
@@ -116,4 +100,90 @@ fn a_new_model_is_updated_by_every_base_and_scheme() {
         .iter()
         .all(|w| *w > 0.0 && *w <= 1.0));
     assert!(iarf.mahalanobis_d2 > iarf.chi2_threshold);
+}
+
+/// y(nominal) − y(true) against H δx for small errors δx of every state, the true state
+/// being the nominal one corrected by δx.
+fn check_rows<M: MeasurementModel>(mut model: M) {
+    let mut nominal = moving_state(1.0);
+    nominal.nav.q_nb = UnitQuaternion::from_euler_angles(0.05, -0.1, 0.8);
+    nominal.nav.v_n = Vector3::new(8.0, -5.0, 0.3);
+    nominal.last_imu.w_ib_b_rad_s = Vector3::new(0.02, -0.01, 0.3);
+    nominal.gyro_bias_rad_s = Vector3::new(1e-3, -2e-3, 5e-4);
+    let lin = model.linearize(
+        &mut nominal.clone(),
+        &mut EpochReport::new(0.0, model.kind(), "ekf"),
+    );
+    let every: Vec<usize> = (0..lin.rows.len()).collect();
+    let y0 = model.predict(&nominal, &every);
+    for (i, (row, predicted)) in lin.rows.iter().zip(&lin.predicted).enumerate() {
+        assert_eq!(y0[i], *predicted);
+        for k in 0..N {
+            // Errors of milliradians, centimetres per second, 1e-4 rad/s.
+            let step = if (DV..DV + 3).contains(&k) {
+                1e-2
+            } else {
+                1e-4
+            };
+            let mut dx = StateVector::zeros();
+            dx[k] = step;
+            let mut plus = nominal.clone();
+            plus.apply_correction(&dx);
+            let mut minus = nominal.clone();
+            minus.apply_correction(&(-dx));
+            let slope =
+                (model.predict(&minus, &[i])[0] - model.predict(&plus, &[i])[0]) / (2.0 * step);
+            assert!(
+                (slope - row[k]).abs() < 1e-6 + 1e-4 * row[k].abs(),
+                "row {i}, state {k}: difference {slope}, H {}",
+                row[k]
+            );
+        }
+    }
+}
+
+#[test]
+fn constraint_rows_match_differences() {
+    check_rows(ZeroVelocity {
+        t_s: 0.0,
+        sigma_mps: 0.02,
+    });
+    let lever = Vector3::new(-1.2, 0.3, -0.5);
+    check_rows(NonHolonomic {
+        t_s: 0.0,
+        lever_arm_b_m: &lever,
+        sigma_lateral_mps: 0.1,
+        sigma_vertical_mps: 0.1,
+    });
+}
+
+/// The zero-rate rows leave out the attitude's part of the earth rate (below 1e-7 rad/s
+/// per milliradian): checked with the attitude columns allowed that much.
+#[test]
+fn zero_rate_rows_match_differences_but_the_earth_rates_attitude_part() {
+    let mut model = ZeroRate {
+        t_s: 0.0,
+        mean_raw_rad_s: Vector3::new(0.02, -0.01, 0.3),
+        sigma_rad_s: 1e-3,
+    };
+    let mut nominal = moving_state(1.0);
+    nominal.last_imu.w_ib_b_rad_s = Vector3::new(0.02, -0.01, 0.3);
+    let lin = model.linearize(
+        &mut nominal.clone(),
+        &mut EpochReport::new(0.0, model.kind(), "ekf"),
+    );
+    for (i, row) in lin.rows.iter().enumerate() {
+        for k in 0..N {
+            let mut dx = StateVector::zeros();
+            dx[k] = 1e-4;
+            let mut plus = nominal.clone();
+            plus.apply_correction(&dx);
+            let slope = (lin.predicted[i] - model.predict(&plus, &[i])[0]) / 1e-4;
+            assert!(
+                (slope - row[k]).abs() < 1e-4,
+                "row {i}, state {k}: difference {slope}, H {}",
+                row[k]
+            );
+        }
+    }
 }

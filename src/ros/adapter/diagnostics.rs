@@ -5,7 +5,8 @@ use crate::ros::msg::{DiagnosticArray, DiagnosticStatus, Header, KeyValue, Time}
 use super::RosAdapter;
 
 impl RosAdapter {
-    /// The /diagnostics report at `stamp`: input counts, rejections by reason, phase and,
+    /// The /diagnostics report at `stamp`: input counts, constraint updates by kind,
+    /// rejections by reason, phase and,
     /// once running, the filter's 3D position sigma (level ERROR when it is not finite);
     /// level WARN while initializing or while a second frame sends on `imu`.
     pub fn diagnostics(&self, node_name: &str, stamp: Time) -> DiagnosticArray {
@@ -24,6 +25,14 @@ impl RosAdapter {
                 let unpaired = self.unpaired_velocities().to_string();
                 values.push(key_value("unpaired_velocity", unpaired));
             }
+        }
+        let updates = self.engine.constraint_updates();
+        for (key, n) in [
+            ("updates_zero_velocity", updates.zero_velocity),
+            ("updates_zero_rate", updates.zero_rate),
+            ("updates_non_holonomic", updates.non_holonomic),
+        ] {
+            values.push(key_value(key, n.to_string()));
         }
         values.extend(self.engine.counters().iter().map(|(reason, n)| KeyValue {
             key: format!("rejected_{}", reason.name()),

@@ -127,6 +127,10 @@ impl Framing {
                     .map(|s| s.sat.constellation),
             ),
             MeasurementKind::Fix => self.fix_service,
+            // The engine reports no epochs of its motion constraints: they use no signal.
+            MeasurementKind::ZeroVelocity
+            | MeasurementKind::ZeroRate
+            | MeasurementKind::NonHolonomic => return,
         };
         if service != NavSatStatus::SERVICE_UNKNOWN {
             self.service = service;

@@ -702,3 +702,42 @@ fn a_refused_solution_says_no_fix_at_its_stamp() {
     let c = adapter.counts();
     assert_eq!((c.non_finite_outputs, c.negative_variance_outputs), (1, 1));
 }
+
+/// Issue 14: with `constraints.zupt` the static scenario's standstill is held by ZUPT and
+/// ZARU updates, counted on /diagnostics (10 Hz and 1 Hz while running); without, the
+/// counts stay 0.
+#[test]
+fn constraint_updates_are_counted_on_diagnostics() {
+    use crate::sim::SimEvent;
+    let counts = |zupt: &str| {
+        let mut config = loose_adapter(OutputFrames::default())
+            .engine()
+            .config()
+            .clone();
+        config.set_parameter("constraints.zupt", zupt).unwrap();
+        let mut adapter = RosAdapter::new(config, OutputFrames::default());
+        for_each_static_event_30_s(|event, stamp| {
+            match event {
+                SimEvent::Imu(s) => adapter.on_imu(&outbound::imu(&s, stamp, "imu")),
+                SimEvent::Fix(f) => adapter.on_fix(&outbound::receiver_fix(&f, stamp, "gnss")),
+                _ => Vec::new(),
+            };
+        });
+        assert_eq!(adapter.engine().init_phase(), None, "running");
+        [
+            "updates_zero_velocity",
+            "updates_zero_rate",
+            "updates_non_holonomic",
+        ]
+        .map(|key| diagnostic(&adapter, key).unwrap().parse::<u64>().unwrap())
+    };
+    let [zero_velocity, zero_rate, non_holonomic] = counts("true");
+    // Running for most of the 30 s: hundreds of ZUPTs, a tenth as many ZARUs.
+    assert!(zero_velocity > 200, "{zero_velocity}");
+    assert!(
+        zero_rate * 10 <= zero_velocity + 10 && zero_rate > 20,
+        "{zero_rate}"
+    );
+    assert_eq!(non_holonomic, 0);
+    assert_eq!(counts("false"), [0, 0, 0]);
+}
