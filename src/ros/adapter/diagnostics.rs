@@ -2,12 +2,14 @@
 
 use crate::ros::msg::{DiagnosticArray, DiagnosticStatus, Header, KeyValue, Time};
 
-use super::RosAdapter;
+use super::{RosAdapter, TfMode};
 
 impl RosAdapter {
     /// The /diagnostics report at `stamp`: input counts, rejections by reason, phase and,
-    /// once running, the filter's 3D position sigma (level ERROR when it is not finite);
-    /// level WARN while initializing or while a second frame sends on `imu`.
+    /// in `tf_mode` `map_to_odom` the `odom → base` transforms heard and the Odometry
+    /// messages without a `map → odom`, once running, the filter's 3D position sigma
+    /// (level ERROR when it is not finite); level WARN while initializing or while a
+    /// second frame sends on `imu`.
     pub fn diagnostics(&self, node_name: &str, stamp: Time) -> DiagnosticArray {
         let phase = match self.engine.init_phase() {
             Some(p) => format!("initializing ({p:?})"),
@@ -24,6 +26,12 @@ impl RosAdapter {
                 let unpaired = self.unpaired_velocities().to_string();
                 values.push(key_value("unpaired_velocity", unpaired));
             }
+        }
+        if self.outputs.frames().published_tf() == TfMode::MapToOdom {
+            let odom = &self.outputs.odom;
+            values.push(key_value("odom_tf_received", odom.heard.to_string()));
+            values.push(key_value("odom_tf_unusable", odom.unusable.to_string()));
+            values.push(key_value("map_to_odom_missing", odom.missing.to_string()));
         }
         values.extend(self.engine.counters().iter().map(|(reason, n)| KeyValue {
             key: format!("rejected_{}", reason.name()),

@@ -7,7 +7,9 @@
 //! `use_sim_time`); publishes `odometry` (nav_msgs/Odometry, `map_frame` → `base_frame`),
 //! `fix/filtered` (NavSatFix), `~/noise_estimates` (NoiseEstimates), `/diagnostics`
 //! (DiagnosticArray, 1 Hz), `/rosout` (rcl_interfaces/Log) and, with `publish_tf`, `/tf`
-//! (tf2_msgs/TFMessage). Serves the parameter services ([`services`]).
+//! (tf2_msgs/TFMessage: `map_frame → base_frame`, or in `tf_mode` `map_to_odom`
+//! `map_frame → odom_frame`, for which it also subscribes `/tf` to hear the base
+//! controller's `odom_frame → base_frame`). Serves the parameter services ([`services`]).
 
 pub mod clock;
 pub mod dds;
@@ -22,7 +24,7 @@ pub mod startup;
 
 use futures::stream::{self, LocalBoxStream, StreamExt};
 
-use crate::ros::adapter::{Published, PublishedSolution, RosAdapter, SolutionMessages};
+use crate::ros::adapter::{Published, PublishedSolution, RosAdapter, SolutionMessages, TfMode};
 use crate::ros::args::NodeArgs;
 use crate::ros::log_limit::LogLimiter;
 use crate::ros::msg::{
@@ -47,6 +49,7 @@ enum Event {
     Fix(Result<NavSatFix, String>),
     Velocity(Result<TwistWithCovarianceStamped, String>),
     Clock(Result<Clock, String>),
+    Tf(Result<TFMessage, String>),
     Param(ParamRequest),
     LogLine(LogLine),
     Tick,
@@ -57,7 +60,7 @@ struct Outputs {
     odometry: Output<Odometry>,
     fix: Output<NavSatFix>,
     noise: Output<NoiseEstimates>,
-    /// Only with `publish_tf`.
+    /// Only with `publish_tf` and a `tf_mode` other than `none`.
     tf: Option<Output<TFMessage>>,
     recorder: Option<Recorder>,
     log: LogLimiter,
@@ -116,11 +119,16 @@ pub fn run(
     let velocity_sub =
         subscription::<TwistWithCovarianceStamped>(&mut node, &names, "gnss/velocity")?;
     let clock_sub = subscription::<Clock>(&mut node, &names, "/clock")?;
+    let tf_sub = if params.frames.published_tf() == TfMode::MapToOdom {
+        Some(subscription::<TFMessage>(&mut node, &names, "/tf")?)
+    } else {
+        None
+    };
     let mut outputs = Outputs {
         odometry: Output::new(&mut node, &names, "odometry")?,
         fix: Output::new(&mut node, &names, "fix/filtered")?,
         noise: Output::new(&mut node, &names, "~/noise_estimates")?,
-        tf: if params.frames.publish_tf {
+        tf: if params.frames.published_tf() != TfMode::None {
             Some(Output::new(&mut node, &names, "/tf")?)
         } else {
             None
@@ -151,6 +159,7 @@ pub fn run(
         events(&velocity_sub, Event::Velocity),
         events(&clock_sub, Event::Clock),
     ];
+    sources.extend(tf_sub.as_ref().map(|sub| events(sub, Event::Tf)));
     sources.extend(housekeeping::housekeeping(
         &services,
         log_lines,
@@ -210,6 +219,11 @@ pub fn run(
                     Vec::new()
                 }
                 Event::Clock(Err(e)) => undecodable(&mut core, "/clock", &e),
+                Event::Tf(Ok(m)) => {
+                    core.on_tf(&m);
+                    Vec::new()
+                }
+                Event::Tf(Err(e)) => undecodable(&mut core, "/tf", &e),
                 Event::Param(request) => {
                     let mut handler = CoreParameters {
                         server: &mut parameters,

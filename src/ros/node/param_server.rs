@@ -4,7 +4,7 @@
 //!
 //! The parameters are the core configuration's (`section.key`, human units, the names of
 //! the parameter file) plus the node's own `use_sim_time`, `map_frame`, `base_frame`,
-//! `publish_tf`, `queue_depth` and `imu_frame`; their descriptions, ranges and read-only flags come
+//! `odom_frame`, `publish_tf`, `tf_mode`, `queue_depth` and `imu_frame`; their descriptions, ranges and read-only flags come
 //! from the parameter table and `NODE_PARAMETERS`. A set request is validated like the
 //! parameter file; only the run-time parameters (and `use_sim_time`) are accepted while
 //! the node runs, every other parameter is read-only and a set is refused with the reason.
@@ -30,8 +30,8 @@ use crate::config::{self, Config, ConfigError, Kind};
 use crate::ros::cdr;
 
 use super::params::{
-    NodeParameter, OutputFrames, BASE_FRAME, DEFAULT_QUEUE_DEPTH, IMU_FRAME, MAP_FRAME, PUBLISH_TF,
-    QUEUE_DEPTH, USE_SIM_TIME,
+    NodeParameter, OutputFrames, BASE_FRAME, DEFAULT_QUEUE_DEPTH, IMU_FRAME, MAP_FRAME, ODOM_FRAME,
+    PUBLISH_TF, QUEUE_DEPTH, TF_MODE, USE_SIM_TIME,
 };
 use crate::ros::adapter::RosAdapter;
 use crate::ros::log_limit::LogLimiter;
@@ -280,7 +280,9 @@ impl ParameterServer {
             (USE_SIM_TIME, Value::Bool(self.use_sim_time)),
             (MAP_FRAME, Value::String(f.map_frame.clone())),
             (BASE_FRAME, Value::String(f.base_frame.clone())),
+            (ODOM_FRAME, Value::String(f.odom_frame.clone())),
             (PUBLISH_TF, Value::Bool(f.publish_tf)),
+            (TF_MODE, Value::String(f.tf_mode.name().to_owned())),
             (QUEUE_DEPTH, Value::Number(self.queue_depth.into())),
             (
                 IMU_FRAME,
@@ -661,7 +663,9 @@ mod tests {
                 "use_sim_time",
                 "map_frame",
                 "base_frame",
+                "odom_frame",
                 "publish_tf",
+                "tf_mode",
                 "queue_depth",
                 "imu_frame"
             ],
@@ -800,6 +804,7 @@ mod tests {
             map_frame: "world_enu".to_owned(),
             base_frame: "imu_link".to_owned(),
             publish_tf: true,
+            ..OutputFrames::default()
         };
         let mut s = ParameterServer::new(false, frames);
         let mut core = RosAdapter::new(Config::default(), OutputFrames::default());
