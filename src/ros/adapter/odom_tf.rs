@@ -162,7 +162,12 @@ impl OdomHistory {
             (_, Some(&(t, pose))) if t == stamp_ns => Some(pose),
             (Some((t0, p0)), Some(&(t1, p1))) => {
                 let s = (stamp_ns - t0) as f64 / (t1 - t0) as f64;
-                Some(p0.lerp_slerp(&p1, s))
+                let mut pose = p0.lerp_slerp(&p1, s);
+                // nalgebra's slerp of two close rotations (acos near 1) leaves the norm
+                // off by ~1e-11, which the composition below would turn into ~1e-9 m at
+                // a 10 m lever arm.
+                pose.rotation.renormalize();
+                Some(pose)
             }
             (Some((t0, p0)), None) if stamp_ns - t0 <= MAX_HOLD_NS => Some(p0),
             _ => None,
@@ -310,7 +315,8 @@ mod tests {
     #[test]
     fn map_to_odom_composes_to_the_fused_pose_between_controller_stamps() {
         let mut h = OdomHistory::new("odom", "base_link");
-        for k in 0..10 {
+        // 20 s from the controller's start: a lever arm of 10 m.
+        for k in 990..1000 {
             let ns = T0_NS + k * PERIOD_NS;
             h.on_tf(&tf("odom", "base_link", ns, &drift(ns)));
         }
@@ -320,7 +326,7 @@ mod tests {
             UnitQuaternion::from_euler_angles(0.01, -0.02, 1.2),
         );
         // On a controller stamp, and at 200 Hz IMU stamps between them.
-        for ns in [T0_NS + 3 * PERIOD_NS, T0_NS + 3 * PERIOD_NS + 5_000_001] {
+        for ns in [T0_NS + 993 * PERIOD_NS, T0_NS + 993 * PERIOD_NS + 5_000_001] {
             let msg = h.map_to_odom(&odometry(ns, &fused)).unwrap();
             let t = &msg.transforms[0];
             assert_eq!(t.header.stamp, time(ns), "the Odometry's stamp exactly");
@@ -331,8 +337,9 @@ mod tests {
             let chained = transform_of(&msg) * drift(ns);
             let (dt_m, dr_rad) = difference(&chained, &fused);
             // The yaw drift is linear in time, so slerp reproduces it; what is left is
-            // f64 rounding of the products (~1e-15 relative).
-            assert!(dt_m < 1e-9 && dr_rad < 1e-9, "{dt_m} m, {dr_rad} rad");
+            // f64 rounding of products of 10 m-scale poses (~1e-15 m). An interpolated
+            // rotation not renormalized gave 3.7e-10 m here.
+            assert!(dt_m < 1e-12 && dr_rad < 1e-12, "{dt_m} m, {dr_rad} rad");
         }
         assert_eq!(h.missing, 0);
     }
