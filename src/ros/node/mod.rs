@@ -6,7 +6,9 @@
 //! `gnss/velocity` (TwistWithCovarianceStamped), `/clock` (rosgraph_msgs/Clock, for
 //! `use_sim_time`); publishes `odometry` (nav_msgs/Odometry, `map_frame` → `base_frame`),
 //! `fix/filtered` (NavSatFix), `~/noise_estimates` (NoiseEstimates), `/diagnostics`
-//! (DiagnosticArray, 1 Hz), `/rosout` (rcl_interfaces/Log) and, with `publish_tf`, `/tf`
+//! (DiagnosticArray, 1 Hz), `/rosout` (rcl_interfaces/Log), `/parameter_events`
+//! (rcl_interfaces/ParameterEvent: each parameter declared at the start, then each
+//! accepted set, as rclcpp announces them) and, with `publish_tf`, `/tf`
 //! (tf2_msgs/TFMessage: `map_frame → base_frame`, or in `tf_mode` `map_to_odom`
 //! `map_frame → odom_frame`, for which it also subscribes `/tf` to hear the base
 //! controller's `odom_frame → base_frame`). Serves the parameter services ([`services`]).
@@ -29,7 +31,7 @@ use crate::ros::args::NodeArgs;
 use crate::ros::log_limit::LogLimiter;
 use crate::ros::msg::{
     Clock, DiagnosticArray, GnssMeasurements, Imu, Log, NavSatFix, NoiseEstimates, Odometry,
-    TFMessage, Time, TwistWithCovarianceStamped,
+    ParameterEvent, TFMessage, Time, TwistWithCovarianceStamped,
 };
 
 use clock::NodeClock;
@@ -139,6 +141,13 @@ pub fn run(
     let diagnostics = Output::<DiagnosticArray>::new(&mut node, &names, "/diagnostics")?;
     let rosout = Output::<Log>::with_qos(&mut node, &names, "/rosout", dds::rosout_qos())?;
     let services = ParameterServices::new(&mut node, dds.service_mapping)?;
+    // Not recorded: the bag writer has no definition of rcl_interfaces' parameter types.
+    let parameter_events = dds::publisher_with::<ParameterEvent>(
+        &mut node,
+        &names,
+        "/parameter_events",
+        dds::parameter_events_qos(),
+    )?;
     let config = params.config;
     let fqn = node.fully_qualified_name();
     let logger = rosout::logger_name(&fqn);
@@ -150,6 +159,10 @@ pub fn run(
         .with_queue_depth(params.queue_depth)
         .with_imu_frame(params.imu_frame);
     let mut clock = NodeClock::default();
+    let stamp = clock.now(parameters.use_sim_time());
+    for event in parameters.declaration_events(core.engine().config(), &fqn, stamp) {
+        publish_parameter_event(&parameter_events, event);
+    }
     let mut stats = InputStats::new(FILTER_NODE_STREAMS);
 
     let mut sources: Vec<LocalBoxStream<'_, Event>> = vec![
@@ -230,6 +243,10 @@ pub fn run(
                         core: &mut core,
                     };
                     services.answer(request, &mut handler);
+                    let stamp = clock.now(parameters.use_sim_time());
+                    if let Some(event) = parameters.take_event(&fqn, stamp) {
+                        publish_parameter_event(&parameter_events, event);
+                    }
                     Vec::new()
                 }
                 Event::LogLine(line) => {
@@ -262,6 +279,15 @@ pub fn run(
         recorder.finish();
     }
     Ok(())
+}
+
+fn publish_parameter_event(
+    publisher: &ros2_client::Publisher<ParameterEvent>,
+    event: ParameterEvent,
+) {
+    if let Err(e) = publisher.publish(event) {
+        log::warn!("publishing /parameter_events failed: {e:?}");
+    }
 }
 
 fn undecodable(core: &mut RosAdapter, topic: &str, error: &str) -> Vec<Published> {

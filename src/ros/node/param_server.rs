@@ -35,6 +35,18 @@ use super::params::{
 };
 use crate::ros::adapter::RosAdapter;
 use crate::ros::log_limit::LogLimiter;
+use crate::ros::msg::{ParameterEvent, Time};
+
+/// An empty `/parameter_events` message of `node`.
+fn event(node: &str, stamp: Time) -> ParameterEvent {
+    ParameterEvent {
+        stamp,
+        node: node.to_owned(),
+        new_parameters: Vec::new(),
+        changed_parameters: Vec::new(),
+        deleted_parameters: Vec::new(),
+    }
+}
 
 /// `ListParameters` depth meaning "no limit".
 const DEPTH_RECURSIVE: u64 = 0;
@@ -71,6 +83,8 @@ pub struct ParameterServer {
     queue_depth: usize,
     imu_frame: Option<String>,
     log: LogLimiter,
+    /// Parameters set since the last [`ParameterServer::take_event`], in order.
+    accepted: Vec<Parameter>,
 }
 
 pub fn value(ptype: u8) -> ParameterValue {
@@ -252,7 +266,38 @@ impl ParameterServer {
             queue_depth: DEFAULT_QUEUE_DEPTH,
             imu_frame: None,
             log: LogLimiter::default(),
+            accepted: Vec::new(),
         }
+    }
+
+    /// The `/parameter_events` message of the sets accepted since the last call, if any:
+    /// their parameters with the values set, in `changed_parameters`, as rclcpp announces
+    /// each accepted set.
+    pub fn take_event(&mut self, node: &str, stamp: Time) -> Option<ParameterEvent> {
+        if self.accepted.is_empty() {
+            return None;
+        }
+        Some(ParameterEvent {
+            changed_parameters: std::mem::take(&mut self.accepted),
+            ..event(node, stamp)
+        })
+    }
+
+    /// The declaration burst of the node's start: rclcpp publishes one event per declared
+    /// parameter with it (and its initial value) in `new_parameters`.
+    pub fn declaration_events(
+        &self,
+        config: &Config,
+        node: &str,
+        stamp: Time,
+    ) -> Vec<ParameterEvent> {
+        self.all(config)
+            .into_iter()
+            .map(|(name, value)| ParameterEvent {
+                new_parameters: vec![Parameter { name, value }],
+                ..event(node, stamp)
+            })
+            .collect()
     }
 
     /// The server reporting `depth` as the node's `queue_depth`.
@@ -505,6 +550,9 @@ impl ParameterServer {
             .map(|p| {
                 let outcome = self.set_one(core, p);
                 self.log_outcome(p, &outcome);
+                if outcome.is_ok() {
+                    self.accepted.push(p.clone());
+                }
                 result(outcome)
             })
             .collect();
@@ -549,6 +597,7 @@ impl ParameterServer {
         let outcome = outcome.and_then(|()| core.retune(config).map_err(|e| e.to_string()));
         if outcome.is_ok() {
             self.use_sim_time = sim_time;
+            self.accepted.extend(params.iter().cloned());
         }
         for p in params.iter().take(MAX_NAMES) {
             self.log_outcome(p, &outcome);
@@ -796,6 +845,56 @@ mod tests {
         );
         assert!(r.result.successful, "{}", r.result.reason);
         assert_eq!(core.engine().config().gnss.cn0_mask_dbhz, 20.0);
+    }
+
+    #[test]
+    fn accepted_sets_and_declarations_become_parameter_events() {
+        let mut s = ParameterServer::new(false, OutputFrames::default());
+        let mut core = RosAdapter::new(Config::default(), OutputFrames::default());
+        let stamp = Time {
+            sec: 1_764_000_000,
+            nanosec: 2_500_001,
+        };
+        let declared = s.declaration_events(core.engine().config(), "/ns/n", stamp);
+        assert_eq!(
+            declared.len(),
+            Config::default().parameters().len() + NODE_PARAMETERS.len()
+        );
+        assert!(declared.iter().all(|e| e.new_parameters.len() == 1
+            && e.changed_parameters.is_empty()
+            && e.node == "/ns/n"
+            && e.stamp == stamp));
+        assert!(s.take_event("/ns/n", stamp).is_none(), "nothing set yet");
+        // One accepted, one refused (read-only): only the accepted one is announced.
+        let mask = param("gnss.elevation_mask_deg", double(12.5));
+        let variant = param("filter.variant", value(ParameterType::STRING));
+        let r = s.set(&mut core, &[mask, variant]);
+        assert!(r.results[0].successful && !r.results[1].successful);
+        let e = s.take_event("/ns/n", stamp).unwrap();
+        assert!(e.new_parameters.is_empty() && e.deleted_parameters.is_empty());
+        assert_eq!(e.changed_parameters.len(), 1);
+        assert_eq!(e.changed_parameters[0].name, "gnss.elevation_mask_deg");
+        assert_eq!(e.changed_parameters[0].value.double_value, 12.5);
+        assert!(s.take_event("/ns/n", stamp).is_none(), "announced once");
+        // An atomic set: all of it or, refused, nothing.
+        let both = [
+            param("gnss.elevation_mask_deg", double(15.0)),
+            param("gnss.cn0_mask_dbhz", double(20.0)),
+        ];
+        assert!(s.set_atomically(&mut core, &both).result.successful);
+        assert_eq!(
+            s.take_event("/ns/n", stamp)
+                .unwrap()
+                .changed_parameters
+                .len(),
+            2
+        );
+        let refused = [
+            both[0].clone(),
+            param("filter.joseph_form", value(ParameterType::BOOL)),
+        ];
+        assert!(!s.set_atomically(&mut core, &refused).result.successful);
+        assert!(s.take_event("/ns/n", stamp).is_none());
     }
 
     #[test]
