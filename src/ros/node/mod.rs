@@ -244,7 +244,7 @@ pub fn run(
                     };
                     services.answer(request, &mut handler);
                     let stamp = clock.now(parameters.use_sim_time());
-                    if let Some(event) = parameters.take_event(&fqn, stamp) {
+                    for event in parameters.take_events(&fqn, stamp) {
                         publish_parameter_event(&parameter_events, event);
                     }
                     Vec::new()

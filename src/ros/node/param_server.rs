@@ -83,8 +83,9 @@ pub struct ParameterServer {
     queue_depth: usize,
     imu_frame: Option<String>,
     log: LogLimiter,
-    /// Parameters set since the last [`ParameterServer::take_event`], in order.
-    accepted: Vec<Parameter>,
+    /// The accepted sets since the last [`ParameterServer::take_events`], in order: one
+    /// per parameter of `set_parameters`, one per `set_parameters_atomically`.
+    accepted: Vec<Vec<Parameter>>,
 }
 
 pub fn value(ptype: u8) -> ParameterValue {
@@ -270,17 +271,17 @@ impl ParameterServer {
         }
     }
 
-    /// The `/parameter_events` message of the sets accepted since the last call, if any:
-    /// their parameters with the values set, in `changed_parameters`, as rclcpp announces
-    /// each accepted set.
-    pub fn take_event(&mut self, node: &str, stamp: Time) -> Option<ParameterEvent> {
-        if self.accepted.is_empty() {
-            return None;
-        }
-        Some(ParameterEvent {
-            changed_parameters: std::mem::take(&mut self.accepted),
-            ..event(node, stamp)
-        })
+    /// The `/parameter_events` messages of the sets accepted since the last call: one per
+    /// set with its parameters and the values set in `changed_parameters`, as rclcpp
+    /// announces them (its `set_parameters` sets each parameter atomically on its own).
+    pub fn take_events(&mut self, node: &str, stamp: Time) -> Vec<ParameterEvent> {
+        std::mem::take(&mut self.accepted)
+            .into_iter()
+            .map(|changed_parameters| ParameterEvent {
+                changed_parameters,
+                ..event(node, stamp)
+            })
+            .collect()
     }
 
     /// The declaration burst of the node's start: rclcpp publishes one event per declared
@@ -551,7 +552,7 @@ impl ParameterServer {
                 let outcome = self.set_one(core, p);
                 self.log_outcome(p, &outcome);
                 if outcome.is_ok() {
-                    self.accepted.push(p.clone());
+                    self.accepted.push(vec![p.clone()]);
                 }
                 result(outcome)
             })
@@ -597,7 +598,7 @@ impl ParameterServer {
         let outcome = outcome.and_then(|()| core.retune(config).map_err(|e| e.to_string()));
         if outcome.is_ok() {
             self.use_sim_time = sim_time;
-            self.accepted.extend(params.iter().cloned());
+            self.accepted.push(params.to_vec());
         }
         for p in params.iter().take(MAX_NAMES) {
             self.log_outcome(p, &outcome);
@@ -864,37 +865,44 @@ mod tests {
             && e.changed_parameters.is_empty()
             && e.node == "/ns/n"
             && e.stamp == stamp));
-        assert!(s.take_event("/ns/n", stamp).is_none(), "nothing set yet");
+        assert!(s.take_events("/ns/n", stamp).is_empty(), "nothing set yet");
         // One accepted, one refused (read-only): only the accepted one is announced.
         let mask = param("gnss.elevation_mask_deg", double(12.5));
         let variant = param("filter.variant", value(ParameterType::STRING));
         let r = s.set(&mut core, &[mask, variant]);
         assert!(r.results[0].successful && !r.results[1].successful);
-        let e = s.take_event("/ns/n", stamp).unwrap();
+        let events = s.take_events("/ns/n", stamp);
+        assert_eq!(events.len(), 1);
+        let e = &events[0];
         assert!(e.new_parameters.is_empty() && e.deleted_parameters.is_empty());
         assert_eq!(e.changed_parameters.len(), 1);
         assert_eq!(e.changed_parameters[0].name, "gnss.elevation_mask_deg");
         assert_eq!(e.changed_parameters[0].value.double_value, 12.5);
-        assert!(s.take_event("/ns/n", stamp).is_none(), "announced once");
+        assert!(s.take_events("/ns/n", stamp).is_empty(), "announced once");
+        // Two accepted in one set_parameters: two events, as rclcpp.
+        let two = [
+            param("gnss.elevation_mask_deg", double(11.0)),
+            param("gnss.cn0_mask_dbhz", double(22.0)),
+        ];
+        assert!(s.set(&mut core, &two).results.iter().all(|r| r.successful));
+        let events = s.take_events("/ns/n", stamp);
+        assert_eq!(events.len(), 2);
+        assert_eq!(events[1].changed_parameters[0].value.double_value, 22.0);
         // An atomic set: all of it or, refused, nothing.
         let both = [
             param("gnss.elevation_mask_deg", double(15.0)),
             param("gnss.cn0_mask_dbhz", double(20.0)),
         ];
         assert!(s.set_atomically(&mut core, &both).result.successful);
-        assert_eq!(
-            s.take_event("/ns/n", stamp)
-                .unwrap()
-                .changed_parameters
-                .len(),
-            2
-        );
+        let events = s.take_events("/ns/n", stamp);
+        assert_eq!(events.len(), 1, "one event for the atomic set");
+        assert_eq!(events[0].changed_parameters.len(), 2);
         let refused = [
             both[0].clone(),
             param("filter.joseph_form", value(ParameterType::BOOL)),
         ];
         assert!(!s.set_atomically(&mut core, &refused).result.successful);
-        assert!(s.take_event("/ns/n", stamp).is_none());
+        assert!(s.take_events("/ns/n", stamp).is_empty());
     }
 
     #[test]
