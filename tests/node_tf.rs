@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 use adaptive_gnss_ins::ros::convert::seconds_to_time;
 use adaptive_gnss_ins::ros::msg::{
     DiagnosticArray, GnssMeasurements, Header, Imu, Odometry, Quaternion, RosMessage, TFMessage,
-    Time, Transform, TransformStamped, Vector3,
+    Time, TransformStamped, Vector3,
 };
 use adaptive_gnss_ins::ros::outbound;
 use adaptive_gnss_ins::sim::{Scenario, SimEvent};
@@ -70,29 +70,12 @@ fn drift(ns: i64, start_ns: i64) -> Isometry3<f64> {
 }
 
 fn controller_tf(ns: i64, pose: &Isometry3<f64>) -> TFMessage {
-    let t = pose.translation.vector;
-    let q = pose.rotation.quaternion();
+    let header = Header {
+        stamp: time(ns),
+        frame_id: "odom".to_owned(),
+    };
     TFMessage {
-        transforms: vec![TransformStamped {
-            header: Header {
-                stamp: time(ns),
-                frame_id: "odom".to_owned(),
-            },
-            child_frame_id: "base_link".to_owned(),
-            transform: Transform {
-                translation: Vector3 {
-                    x: t.x,
-                    y: t.y,
-                    z: t.z,
-                },
-                rotation: Quaternion {
-                    x: q.i,
-                    y: q.j,
-                    z: q.k,
-                    w: q.w,
-                },
-            },
-        }],
+        transforms: vec![outbound::transform_stamped(header, "base_link", pose)],
     }
 }
 

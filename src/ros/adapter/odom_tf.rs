@@ -7,9 +7,8 @@ use std::collections::VecDeque;
 
 use nalgebra::{Isometry3, Quaternion as NaQuaternion, Translation3, UnitQuaternion};
 
-use crate::ros::msg::{
-    Header, Odometry, Quaternion, TFMessage, Time, Transform, TransformStamped, Vector3,
-};
+use crate::ros::msg::{Header, Odometry, Quaternion, TFMessage, Time, Vector3};
+use crate::ros::outbound;
 
 /// What the node publishes on `/tf` with each Odometry.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -194,29 +193,16 @@ impl OdomHistory {
             return None;
         };
         let map_odom = map_base * odom_base.inverse();
-        let t = map_odom.translation.vector;
-        let q = map_odom.rotation.quaternion();
+        let header = Header {
+            stamp: odometry.header.stamp,
+            frame_id: odometry.header.frame_id.clone(),
+        };
         Some(TFMessage {
-            transforms: vec![TransformStamped {
-                header: Header {
-                    stamp: odometry.header.stamp,
-                    frame_id: odometry.header.frame_id.clone(),
-                },
-                child_frame_id: self.odom_frame.clone(),
-                transform: Transform {
-                    translation: Vector3 {
-                        x: t.x,
-                        y: t.y,
-                        z: t.z,
-                    },
-                    rotation: Quaternion {
-                        x: q.i,
-                        y: q.j,
-                        z: q.k,
-                        w: q.w,
-                    },
-                },
-            }],
+            transforms: vec![outbound::transform_stamped(
+                header,
+                &self.odom_frame,
+                &map_odom,
+            )],
         })
     }
 }
@@ -253,23 +239,12 @@ mod tests {
     }
 
     fn tf(parent: &str, child: &str, ns: i64, pose: &Isometry3<f64>) -> TFMessage {
-        let t = pose.translation.vector;
+        let header = Header {
+            stamp: time(ns),
+            frame_id: parent.to_owned(),
+        };
         TFMessage {
-            transforms: vec![TransformStamped {
-                header: Header {
-                    stamp: time(ns),
-                    frame_id: parent.to_owned(),
-                },
-                child_frame_id: child.to_owned(),
-                transform: Transform {
-                    translation: Vector3 {
-                        x: t.x,
-                        y: t.y,
-                        z: t.z,
-                    },
-                    rotation: quaternion(&pose.rotation),
-                },
-            }],
+            transforms: vec![outbound::transform_stamped(header, child, pose)],
         }
     }
 
