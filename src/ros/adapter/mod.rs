@@ -47,7 +47,7 @@ use crate::ros::log_limit::LogLimiter;
 pub use counts::{Input, InputCounts};
 use frame_lock::FrameLock;
 pub use inputs::InputMessage;
-pub use odom_tf::{TfMode, MAX_HOLD_NS};
+pub use odom_tf::TfMode;
 pub use outputs::{OutputFrames, Published, PublishedEpoch, PublishedSolution, SolutionMessages};
 use stamp_book::StampBook;
 use time_line::TimeLine;

@@ -52,7 +52,7 @@ const REMEMBERED_TRANSFORMS: usize = 256;
 /// of the same time; tf2 would refuse to extrapolate and robot_localization then falls
 /// back to the latest transform. 0.1 s is five periods of a 50 Hz controller: a silent
 /// controller stops `map → odom` after it instead of freezing a stale one.
-pub const MAX_HOLD_NS: i64 = 100_000_000;
+const MAX_HOLD_NS: i64 = 100_000_000;
 
 /// Choice: a transform this much older than the newest is a time jump (a bag played
 /// again, a restarted simulation): the history is cleared, as tf2 clears its buffer on a
