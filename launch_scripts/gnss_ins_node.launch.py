@@ -16,10 +16,12 @@ Arguments:
   remappings of the node's relative topics imu, gnss/measurements, gnss/fix,
   gnss/velocity, odometry and fix/filtered (its NavSatFix, named apart from a driver's
   fix in the same namespace);
-- the node's own parameters use_sim_time (bool), map_frame, base_frame (frame ids),
-  publish_tf (bool), queue_depth (int) and imu_frame (a frame id). Their default is ''
+- the node's own parameters use_sim_time (bool), map_frame, base_frame, odom_frame
+  (frame ids), publish_tf (bool), tf_mode (map_to_base_link, map_to_odom or none; see
+  docs/tf.md), queue_depth (int) and imu_frame (a frame id). Their default is ''
   meaning "not set": the value then comes from the params file or, when the file has
-  none, from the node's default (false, map, base_link, false, 200, '' = learnt). Choice: a parameters dict given after the
+  none, from the node's default (false, map, base_link, odom, false, map_to_base_link,
+  200, '' = learnt). Choice: a parameters dict given after the
   params file overrides it, so only the arguments the user set are passed; a default that
   is always passed would silently override the params file.
 - with_ubx_adapter (default false): also start gnss_ins_ubx_node (named ubx_node_name),
@@ -52,7 +54,9 @@ NODE_PARAMETERS = {
     'use_sim_time': (bool, 'node time follows /clock (node default: false)'),
     'map_frame': (str, 'frame of the odometry pose and TF parent (node default: map)'),
     'base_frame': (str, 'body frame: odometry child and fix frame (node default: base_link)'),
-    'publish_tf': (bool, 'publish map_frame -> base_frame on /tf (node default: false)'),
+    'odom_frame': (str, 'parent of base_frame in the base controller TF (node default: odom)'),
+    'publish_tf': (bool, 'publish the TF of tf_mode on /tf (node default: false)'),
+    'tf_mode': (str, 'map_to_base_link, map_to_odom or none (node default: map_to_base_link)'),
     'queue_depth': (int, 'history depth of subscriptions and publishers (node default: 200)'),
     'imu_frame': (str, 'the IMU frame_id; others are dropped (node default: learnt)'),
 }

@@ -7,14 +7,14 @@
 # PRESET is a file name of params/ without .yaml (default: ermakf), e.g. ekf, ekf_loose;
 # it is loaded after the manual params/ekf.yaml (the presets hold only what differs).
 # NAME:=VALUE sets one of the node's own parameters as the launch file's arguments do:
-# use_sim_time, map_frame, base_frame, publish_tf, queue_depth, imu_frame (passed as -p NAME:=VALUE,
-# which wins over the preset). Extra arguments follow --ros-args, e.g. -r __ns:=/robot
+# use_sim_time, map_frame, base_frame, odom_frame, publish_tf, tf_mode, queue_depth,
+# imu_frame (passed as -p NAME:=VALUE, which wins over the preset). Extra arguments follow --ros-args, e.g. -r __ns:=/robot
 # -r imu:=/sensors/imu -p gnss.elevation_mask_deg:=15.0.
 # With GNSS_INS_DRY_RUN=1 the command is printed instead of run.
 set -euo pipefail
 
 # The node's own parameters (src/ros/node/params.rs, NODE_PARAMETERS).
-node_parameters=(use_sim_time map_frame base_frame publish_tf queue_depth imu_frame)
+node_parameters=(use_sim_time map_frame base_frame odom_frame publish_tf tf_mode queue_depth imu_frame)
 
 repo_root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 preset="${1:-ermakf}"

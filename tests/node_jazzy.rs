@@ -131,7 +131,8 @@ fn jazzy_rclpy_plays_a_bag_and_receives_the_replay_solution() {
 /// rclpy's AsyncParameterClient (what `ros2 param` uses) against the node's parameter
 /// services in Fast DDS's request/reply layout: lists, values, types, a description for
 /// every parameter, an accepted set, sets refused with their reasons (read-only, out of
-/// range, wrong type) and an all-or-nothing atomic set.
+/// range, wrong type) and an all-or-nothing atomic set; each accepted set is announced on
+/// `/parameter_events` with its value, a refused one not at all.
 #[test]
 fn jazzy_parameter_client_lists_describes_and_sets_parameters() {
     let python = venv_support::python();
@@ -139,7 +140,15 @@ fn jazzy_parameter_client_lists_describes_and_sets_parameters() {
         return;
     }
     let _node = start_node(&[]);
-    let summary = run_peer(&python, "jazzy_parameters.py", &[]);
+    let summary = run_peer(
+        &python,
+        "jazzy_parameters.py",
+        &["--require-parameter-events"],
+    );
+    // One /parameter_events message per accepted set, with the value set (issue 16).
+    let events = &summary["parameter_events"];
+    assert_eq!(events["events"], 2, "{summary}");
+    assert_eq!(events["announced"][0][0][1], 12.5, "{summary}");
     assert!(summary["listed"].as_u64().unwrap_or(0) > 50, "{summary}");
     let reason = summary["refused_read_only"].as_str().unwrap_or_default();
     assert!(reason.contains("read-only"), "{reason}");

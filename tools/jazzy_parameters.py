@@ -9,7 +9,8 @@ against the node's documented behaviour (params/ekf.yaml defaults; a description
 parameter; the runtime parameters settable, the others read-only and a set of them refused
 with the reason; an invalid value refused; an atomic set all or nothing). Leaves every
 parameter as it found it. It also listens on /parameter_events and reports what the node
-announced there; with `--require-parameter-events` each accepted set must be announced.
+announced there; with `--require-parameter-events` each accepted set must be announced, once,
+with its new value.
 
 Prints a JSON summary on stdout, every failed check on stderr, and exits 1 if any failed.
 See tools/jazzy_common.py for the environment.
@@ -115,7 +116,7 @@ def check_sets(checks, client):
     summary, accepted = {}, []
     applied = client.set(MASK, 12.5)
     if checks.that(applied is not None and applied.successful, f'set {MASK} 12.5: {applied}'):
-        accepted.append(MASK)
+        accepted.append((MASK, 12.5))
     checks.that(client.value(MASK) == 12.5, 'the elevation mask reads back as set')
     refused = client.set(VARIANT, 'ermakf')
     checks.that(refused is not None and not refused.successful and 'read-only' in refused.reason,
@@ -141,24 +142,28 @@ def check_sets(checks, client):
     restore = client.call('restore atomically', client.client.set_parameters_atomically(
         [Parameter(MASK, value=10.0)]))
     if checks.that(restore is not None and restore.result.successful, f'restore: {restore}'):
-        accepted.append(MASK)
+        accepted.append((MASK, 10.0))
     checks.that(client.value(MASK) == 10.0, 'the elevation mask is back at its default')
     return summary, accepted
 
 
 def check_parameter_events(checks, jazzy, fqn, accepted, required):
-    """What the node announced on /parameter_events for the accepted sets."""
-    wait_until(lambda: len(own_events(jazzy, fqn)) >= len(accepted), 2.0 if required else 0.5)
-    events = own_events(jazzy, fqn)
-    announced = [p.name for e in events for p in e.changed_parameters]
+    """What the node announced on /parameter_events for the accepted sets: one event with
+    the name and the new value in changed_parameters per accepted set, nothing for a
+    refused one (the declaration events of the start carry new_parameters only)."""
+    wait_until(lambda: len(change_events(jazzy, fqn)) >= len(accepted), 2.0 if required else 0.5)
+    events = change_events(jazzy, fqn)
+    announced = [[(p.name, parameter_value_to_python(p.value)) for p in e.changed_parameters]
+                 for e in events]
     if required:
-        checks.that(announced == accepted, f'/parameter_events announced {announced}, '
-                                           f'the accepted sets were {accepted}')
+        checks.that(announced == [[a] for a in accepted],
+                    f'/parameter_events announced {announced}, the accepted sets were {accepted}')
     return {'events': len(events), 'announced': announced, 'accepted_sets': accepted}
 
 
-def own_events(jazzy, fqn):
-    return [e for e in jazzy.messages('parameter_events') if e.node == fqn]
+def change_events(jazzy, fqn):
+    return [e for e in jazzy.messages('parameter_events')
+            if e.node == fqn and e.changed_parameters]
 
 
 def main():

@@ -114,6 +114,29 @@ pub fn transform(odometry: &Odometry) -> TFMessage {
     }
 }
 
+/// The transform `header.frame_id` → `child_frame_id` that places the child at `pose` in
+/// the parent frame.
+pub fn transform_stamped(
+    header: Header,
+    child_frame_id: &str,
+    pose: &nalgebra::Isometry3<f64>,
+) -> TransformStamped {
+    let q = pose.rotation.quaternion();
+    TransformStamped {
+        header,
+        child_frame_id: child_frame_id.to_owned(),
+        transform: Transform {
+            translation: vector3(&pose.translation.vector),
+            rotation: Quaternion {
+                x: q.i,
+                y: q.j,
+                z: q.k,
+                w: q.w,
+            },
+        },
+    }
+}
+
 /// sensor_msgs/NavSatFix of the body position, with the filter's ENU covariance (known);
 /// `service` holds the bits of the constellations the filter used ([`service_of`]).
 pub fn nav_sat_fix(solution: &Solution, stamp: Time, frame_id: &str, service: u16) -> NavSatFix {

@@ -2,13 +2,14 @@
 
 use crate::ros::msg::{DiagnosticArray, DiagnosticStatus, Header, KeyValue, Time};
 
-use super::RosAdapter;
+use super::{RosAdapter, TfMode};
 
 impl RosAdapter {
     /// The /diagnostics report at `stamp`: input counts, constraint updates by kind,
-    /// rejections by reason, phase and,
-    /// once running, the filter's 3D position sigma (level ERROR when it is not finite);
-    /// level WARN while initializing or while a second frame sends on `imu`.
+    /// rejections by reason, phase and, in `tf_mode` `map_to_odom` the `odom → base`
+    /// transforms heard and the Odometry messages without a `map → odom`, once running,
+    /// the filter's 3D position sigma (level ERROR when it is not finite); level WARN
+    /// while initializing or while a second frame sends on `imu`.
     pub fn diagnostics(&self, node_name: &str, stamp: Time) -> DiagnosticArray {
         let phase = match self.engine.init_phase() {
             Some(p) => format!("initializing ({p:?})"),
@@ -33,6 +34,12 @@ impl RosAdapter {
             ("updates_non_holonomic", updates.non_holonomic),
         ] {
             values.push(key_value(key, n.to_string()));
+        }
+        if self.outputs.frames().published_tf() == TfMode::MapToOdom {
+            let odom = &self.outputs.odom;
+            values.push(key_value("odom_tf_received", odom.heard.to_string()));
+            values.push(key_value("odom_tf_unusable", odom.unusable.to_string()));
+            values.push(key_value("map_to_odom_missing", odom.missing.to_string()));
         }
         values.extend(self.engine.counters().iter().map(|(reason, n)| KeyValue {
             key: format!("rejected_{}", reason.name()),

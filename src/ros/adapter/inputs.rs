@@ -6,7 +6,9 @@ use crate::gnss::GnssEpoch;
 use crate::ins::ImuSample;
 use crate::ros::convert::GnssVelocity;
 use crate::ros::fix_velocity::{FramedFix, Joined, VelocityUse};
-use crate::ros::msg::{GnssMeasurements, Imu, NavSatFix, Time, TwistWithCovarianceStamped};
+use crate::ros::msg::{
+    GnssMeasurements, Imu, NavSatFix, TFMessage, Time, TwistWithCovarianceStamped,
+};
 
 use super::frame_lock::Admission;
 use super::time_line::Verdict;
@@ -39,6 +41,12 @@ impl RosAdapter {
             "undecodable",
             &format!("undecodable message on {topic}: {error}"),
         );
+    }
+
+    /// Takes the base controller's `odom_frame → base_frame` transforms of a `/tf` message
+    /// (used in `tf_mode` `map_to_odom`; other transforms are ignored).
+    pub fn on_tf(&mut self, msg: &TFMessage) {
+        self.outputs.odom.on_tf(msg);
     }
 
     /// Handles one sensor_msgs/Imu.

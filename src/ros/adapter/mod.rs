@@ -10,7 +10,8 @@
 //! the join releases at this IMU time) → [`Engine::push_imu`] (mechanization and
 //! covariance propagation, a [`Solution`](crate::engine::Solution) per sample or at
 //! `output.rate_hz`) → `outputs` (the guard: every number finite, no negative variance;
-//! then Odometry, NavSatFix and, with `publish_tf`, the TF, stamped with the sample's
+//! then Odometry, NavSatFix and, with `publish_tf`, the TF of `tf_mode` (`odom_tf`:
+//! `map → base`, or `map → odom` from the `/tf` fed to [`RosAdapter::on_tf`]), stamped with the sample's
 //! own ROS stamp from `stamp_book`) → [`Published::Solution`], which keeps the solution
 //! for `replay`'s CSV and scoring; a refused one, or a GNSS input while the filter has
 //! no solution, becomes [`Published::NoFix`].
@@ -31,6 +32,7 @@ mod diagnostics;
 mod frame_lock;
 mod guard;
 mod inputs;
+mod odom_tf;
 mod outputs;
 mod stamp_book;
 #[cfg(test)]
@@ -45,6 +47,7 @@ use crate::ros::log_limit::LogLimiter;
 pub use counts::{Input, InputCounts};
 use frame_lock::FrameLock;
 pub use inputs::InputMessage;
+pub use odom_tf::TfMode;
 pub use outputs::{OutputFrames, Published, PublishedEpoch, PublishedSolution, SolutionMessages};
 use stamp_book::StampBook;
 use time_line::TimeLine;

@@ -7,6 +7,7 @@ use crate::ros::msg::{NavSatFix, NavSatStatus, NoiseEstimates, Odometry, TFMessa
 use crate::ros::outbound;
 
 use super::guard::{self, Unpublishable};
+use super::odom_tf::{OdomHistory, TfMode};
 use super::stamp_book::StampBook;
 use super::RosAdapter;
 
@@ -20,8 +21,24 @@ pub struct OutputFrames {
     pub map_frame: String,
     /// Child frame of Odometry and TF, frame of NavSatFix (default `base_link`).
     pub base_frame: String,
-    /// Publish the TF `map_frame` → `base_frame` (default false).
+    /// Parent of `base_frame` in the base controller's `/tf` (default `odom`), for
+    /// [`TfMode::MapToOdom`].
+    pub odom_frame: String,
+    /// Publish a TF at all (default false; false publishes none whatever `tf_mode` says).
     pub publish_tf: bool,
+    /// Which TF, with `publish_tf` (default [`TfMode::MapToBaseLink`]).
+    pub tf_mode: TfMode,
+}
+
+impl OutputFrames {
+    /// The TF published: `tf_mode` with `publish_tf`, else none.
+    pub fn published_tf(&self) -> TfMode {
+        if self.publish_tf {
+            self.tf_mode
+        } else {
+            TfMode::None
+        }
+    }
 }
 
 impl Default for OutputFrames {
@@ -29,7 +46,9 @@ impl Default for OutputFrames {
         Self {
             map_frame: "map".to_owned(),
             base_frame: "base_link".to_owned(),
+            odom_frame: "odom".to_owned(),
             publish_tf: false,
+            tf_mode: TfMode::MapToBaseLink,
         }
     }
 }
@@ -39,7 +58,7 @@ impl Default for OutputFrames {
 /// twice and nothing unpublished is scored.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Published {
-    /// A solution, on `odometry`, `fix` and (with `publish_tf`) `/tf`.
+    /// A solution, on `odometry`, `fix/filtered` and (with `publish_tf`) `/tf`.
     Solution(PublishedSolution),
     /// An epoch's report, on `~/noise_estimates`.
     Epoch(Box<PublishedEpoch>),
@@ -75,7 +94,9 @@ pub struct SolutionMessages {
     pub odometry: Odometry,
     /// The body position, in `base_frame`.
     pub fix: NavSatFix,
-    /// `map_frame` → `base_frame` (only with `publish_tf`).
+    /// With `publish_tf`: `map_frame` → `base_frame` ([`TfMode::MapToBaseLink`]) or
+    /// `map_frame` → `odom_frame` ([`TfMode::MapToOdom`], once an `odom_frame` →
+    /// `base_frame` near the stamp was heard).
     pub tf: Option<TFMessage>,
 }
 
@@ -91,11 +112,14 @@ pub(super) struct Framing {
     service: u16,
     /// NavSatFix service bits of the last receiver fix received (loose coupling).
     fix_service: u16,
+    /// The base controller's `odom → base` transforms ([`TfMode::MapToOdom`]).
+    pub(super) odom: OdomHistory,
 }
 
 impl Framing {
     pub(super) fn new(frames: OutputFrames, datum: Option<Llh>) -> Self {
         Self {
+            odom: OdomHistory::new(&frames.odom_frame, &frames.base_frame),
             frames,
             datum,
             messages: true,
@@ -188,11 +212,12 @@ impl Framing {
         let odometry = outbound::odometry(solution, &datum, stamp, &f.map_frame, &f.base_frame);
         let fix = outbound::nav_sat_fix(solution, stamp, &f.base_frame, self.service);
         guard::judge_messages(&odometry, &fix)?;
-        Ok(SolutionMessages {
-            tf: f.publish_tf.then(|| outbound::transform(&odometry)),
-            odometry,
-            fix,
-        })
+        let tf = match f.published_tf() {
+            TfMode::MapToBaseLink => Some(outbound::transform(&odometry)),
+            TfMode::MapToOdom => self.odom.map_to_odom(&odometry),
+            TfMode::None => None,
+        };
+        Ok(SolutionMessages { tf, odometry, fix })
     }
 }
 

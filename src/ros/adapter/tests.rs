@@ -210,6 +210,7 @@ fn velocities_pair_with_their_fixes_bad_ones_are_counted_and_tf_follows_odometry
         map_frame: "map".to_owned(),
         base_frame: "imu_link".to_owned(),
         publish_tf: true,
+        ..OutputFrames::default()
     };
     let mut adapter = loose_adapter(frames);
     let mut out = Vec::new();

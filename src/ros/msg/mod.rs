@@ -32,7 +32,7 @@ pub use gnss::{
 };
 pub use multi_array::{MultiArrayDimension, MultiArrayLayout, UInt8MultiArray};
 pub use nav::Odometry;
-pub use rcl::Log;
+pub use rcl::{Log, ParameterEvent};
 pub use rosgraph::Clock;
 pub use sensor::{Imu, NavSatFix, NavSatStatus};
 pub use tf2::TFMessage;

@@ -1,5 +1,6 @@
-//! `rcl_interfaces/msg/Log`.
+//! `rcl_interfaces/msg/Log` and `rcl_interfaces/msg/ParameterEvent`.
 
+use ros2_client::parameters::raw::Parameter;
 use serde::{Deserialize, Serialize};
 
 use super::{ros_message, Time};
@@ -36,3 +37,21 @@ impl Log {
     /// Fatal level.
     pub const FATAL: u8 = 50;
 }
+
+/// `rcl_interfaces/msg/ParameterEvent`: what a node declared, changed or deleted, on
+/// `/parameter_events`. `Parameter` (name and `ParameterValue`) is ros2-client's, the type
+/// the parameter services already speak.
+#[derive(Serialize, Deserialize, Debug, Clone)]
+pub struct ParameterEvent {
+    /// When it happened (the node's clock).
+    pub stamp: Time,
+    /// The node's fully qualified name.
+    pub node: String,
+    /// Parameters declared.
+    pub new_parameters: Vec<Parameter>,
+    /// Parameters set, with their new values.
+    pub changed_parameters: Vec<Parameter>,
+    /// Parameters undeclared.
+    pub deleted_parameters: Vec<Parameter>,
+}
+ros_message!(ParameterEvent, "rcl_interfaces", "ParameterEvent");

@@ -107,7 +107,14 @@ pub fn subscription<M: RosMessage + 'static>(
         .map_err(dds_error)
 }
 
-fn publisher_with<M: RosMessage>(
+/// `/parameter_events` QoS as rclcpp offers it (`rmw_qos_profile_parameter_events`):
+/// reliable, volatile, the last 1000 events.
+pub fn parameter_events_qos() -> QosProfile {
+    QosProfile::publisher_default().history(History::KeepLast { depth: 1000 })
+}
+
+/// A publisher on `relative` resolved by `names` (not recorded: see [`Output`]).
+pub fn publisher_with<M: RosMessage>(
     node: &mut Node,
     names: &Names,
     relative: &str,

@@ -6,8 +6,12 @@
 //! `gnss/velocity` (TwistWithCovarianceStamped), `/clock` (rosgraph_msgs/Clock, for
 //! `use_sim_time`); publishes `odometry` (nav_msgs/Odometry, `map_frame` → `base_frame`),
 //! `fix/filtered` (NavSatFix), `~/noise_estimates` (NoiseEstimates), `/diagnostics`
-//! (DiagnosticArray, 1 Hz), `/rosout` (rcl_interfaces/Log) and, with `publish_tf`, `/tf`
-//! (tf2_msgs/TFMessage). Serves the parameter services ([`services`]).
+//! (DiagnosticArray, 1 Hz), `/rosout` (rcl_interfaces/Log), `/parameter_events`
+//! (rcl_interfaces/ParameterEvent: each parameter declared at the start, then each
+//! accepted set, as rclcpp announces them) and, with `publish_tf`, `/tf`
+//! (tf2_msgs/TFMessage: `map_frame → base_frame`, or in `tf_mode` `map_to_odom`
+//! `map_frame → odom_frame`, for which it also subscribes `/tf` to hear the base
+//! controller's `odom_frame → base_frame`). Serves the parameter services ([`services`]).
 
 pub mod clock;
 pub mod dds;
@@ -22,12 +26,12 @@ pub mod startup;
 
 use futures::stream::{self, LocalBoxStream, StreamExt};
 
-use crate::ros::adapter::{Published, PublishedSolution, RosAdapter, SolutionMessages};
+use crate::ros::adapter::{Published, PublishedSolution, RosAdapter, SolutionMessages, TfMode};
 use crate::ros::args::NodeArgs;
 use crate::ros::log_limit::LogLimiter;
 use crate::ros::msg::{
     Clock, DiagnosticArray, GnssMeasurements, Imu, Log, NavSatFix, NoiseEstimates, Odometry,
-    TFMessage, Time, TwistWithCovarianceStamped,
+    ParameterEvent, TFMessage, Time, TwistWithCovarianceStamped,
 };
 
 use clock::NodeClock;
@@ -47,6 +51,7 @@ enum Event {
     Fix(Result<NavSatFix, String>),
     Velocity(Result<TwistWithCovarianceStamped, String>),
     Clock(Result<Clock, String>),
+    Tf(Result<TFMessage, String>),
     Param(ParamRequest),
     LogLine(LogLine),
     Tick,
@@ -57,7 +62,7 @@ struct Outputs {
     odometry: Output<Odometry>,
     fix: Output<NavSatFix>,
     noise: Output<NoiseEstimates>,
-    /// Only with `publish_tf`.
+    /// Only with `publish_tf` and a `tf_mode` other than `none`.
     tf: Option<Output<TFMessage>>,
     recorder: Option<Recorder>,
     log: LogLimiter,
@@ -116,11 +121,16 @@ pub fn run(
     let velocity_sub =
         subscription::<TwistWithCovarianceStamped>(&mut node, &names, "gnss/velocity")?;
     let clock_sub = subscription::<Clock>(&mut node, &names, "/clock")?;
+    let tf_sub = if params.frames.published_tf() == TfMode::MapToOdom {
+        Some(subscription::<TFMessage>(&mut node, &names, "/tf")?)
+    } else {
+        None
+    };
     let mut outputs = Outputs {
         odometry: Output::new(&mut node, &names, "odometry")?,
         fix: Output::new(&mut node, &names, "fix/filtered")?,
         noise: Output::new(&mut node, &names, "~/noise_estimates")?,
-        tf: if params.frames.publish_tf {
+        tf: if params.frames.published_tf() != TfMode::None {
             Some(Output::new(&mut node, &names, "/tf")?)
         } else {
             None
@@ -131,6 +141,13 @@ pub fn run(
     let diagnostics = Output::<DiagnosticArray>::new(&mut node, &names, "/diagnostics")?;
     let rosout = Output::<Log>::with_qos(&mut node, &names, "/rosout", dds::rosout_qos())?;
     let services = ParameterServices::new(&mut node, dds.service_mapping)?;
+    // Not recorded: the bag writer has no definition of rcl_interfaces' parameter types.
+    let parameter_events = dds::publisher_with::<ParameterEvent>(
+        &mut node,
+        &names,
+        "/parameter_events",
+        dds::parameter_events_qos(),
+    )?;
     let config = params.config;
     let fqn = node.fully_qualified_name();
     let logger = rosout::logger_name(&fqn);
@@ -142,6 +159,10 @@ pub fn run(
         .with_queue_depth(params.queue_depth)
         .with_imu_frame(params.imu_frame);
     let mut clock = NodeClock::default();
+    let stamp = clock.now(parameters.use_sim_time());
+    for event in parameters.declaration_events(core.engine().config(), &fqn, stamp) {
+        publish_parameter_event(&parameter_events, event);
+    }
     let mut stats = InputStats::new(FILTER_NODE_STREAMS);
 
     let mut sources: Vec<LocalBoxStream<'_, Event>> = vec![
@@ -151,6 +172,7 @@ pub fn run(
         events(&velocity_sub, Event::Velocity),
         events(&clock_sub, Event::Clock),
     ];
+    sources.extend(tf_sub.as_ref().map(|sub| events(sub, Event::Tf)));
     sources.extend(housekeeping::housekeeping(
         &services,
         log_lines,
@@ -210,12 +232,21 @@ pub fn run(
                     Vec::new()
                 }
                 Event::Clock(Err(e)) => undecodable(&mut core, "/clock", &e),
+                Event::Tf(Ok(m)) => {
+                    core.on_tf(&m);
+                    Vec::new()
+                }
+                Event::Tf(Err(e)) => undecodable(&mut core, "/tf", &e),
                 Event::Param(request) => {
                     let mut handler = CoreParameters {
                         server: &mut parameters,
                         core: &mut core,
                     };
                     services.answer(request, &mut handler);
+                    let stamp = clock.now(parameters.use_sim_time());
+                    for event in parameters.take_events(&fqn, stamp) {
+                        publish_parameter_event(&parameter_events, event);
+                    }
                     Vec::new()
                 }
                 Event::LogLine(line) => {
@@ -248,6 +279,15 @@ pub fn run(
         recorder.finish();
     }
     Ok(())
+}
+
+fn publish_parameter_event(
+    publisher: &ros2_client::Publisher<ParameterEvent>,
+    event: ParameterEvent,
+) {
+    if let Err(e) = publisher.publish(event) {
+        log::warn!("publishing /parameter_events failed: {e:?}");
+    }
 }
 
 fn undecodable(core: &mut RosAdapter, topic: &str, error: &str) -> Vec<Published> {

@@ -4,7 +4,7 @@
 //!
 //! The parameters are the core configuration's (`section.key`, human units, the names of
 //! the parameter file) plus the node's own `use_sim_time`, `map_frame`, `base_frame`,
-//! `publish_tf`, `queue_depth` and `imu_frame`; their descriptions, ranges and read-only flags come
+//! `odom_frame`, `publish_tf`, `tf_mode`, `queue_depth` and `imu_frame`; their descriptions, ranges and read-only flags come
 //! from the parameter table and `NODE_PARAMETERS`. A set request is validated like the
 //! parameter file; only the run-time parameters (and `use_sim_time`) are accepted while
 //! the node runs, every other parameter is read-only and a set is refused with the reason.
@@ -30,11 +30,23 @@ use crate::config::{self, Config, ConfigError, Kind};
 use crate::ros::cdr;
 
 use super::params::{
-    NodeParameter, OutputFrames, BASE_FRAME, DEFAULT_QUEUE_DEPTH, IMU_FRAME, MAP_FRAME, PUBLISH_TF,
-    QUEUE_DEPTH, USE_SIM_TIME,
+    NodeParameter, OutputFrames, BASE_FRAME, DEFAULT_QUEUE_DEPTH, IMU_FRAME, MAP_FRAME, ODOM_FRAME,
+    PUBLISH_TF, QUEUE_DEPTH, TF_MODE, USE_SIM_TIME,
 };
 use crate::ros::adapter::RosAdapter;
 use crate::ros::log_limit::LogLimiter;
+use crate::ros::msg::{ParameterEvent, Time};
+
+/// An empty `/parameter_events` message of `node`.
+fn event(node: &str, stamp: Time) -> ParameterEvent {
+    ParameterEvent {
+        stamp,
+        node: node.to_owned(),
+        new_parameters: Vec::new(),
+        changed_parameters: Vec::new(),
+        deleted_parameters: Vec::new(),
+    }
+}
 
 /// `ListParameters` depth meaning "no limit".
 const DEPTH_RECURSIVE: u64 = 0;
@@ -71,6 +83,9 @@ pub struct ParameterServer {
     queue_depth: usize,
     imu_frame: Option<String>,
     log: LogLimiter,
+    /// The accepted sets since the last [`ParameterServer::take_events`], in order: one
+    /// per parameter of `set_parameters`, one per `set_parameters_atomically`.
+    accepted: Vec<Vec<Parameter>>,
 }
 
 pub fn value(ptype: u8) -> ParameterValue {
@@ -252,7 +267,38 @@ impl ParameterServer {
             queue_depth: DEFAULT_QUEUE_DEPTH,
             imu_frame: None,
             log: LogLimiter::default(),
+            accepted: Vec::new(),
         }
+    }
+
+    /// The `/parameter_events` messages of the sets accepted since the last call: one per
+    /// set with its parameters and the values set in `changed_parameters`, as rclcpp
+    /// announces them (its `set_parameters` sets each parameter atomically on its own).
+    pub fn take_events(&mut self, node: &str, stamp: Time) -> Vec<ParameterEvent> {
+        std::mem::take(&mut self.accepted)
+            .into_iter()
+            .map(|changed_parameters| ParameterEvent {
+                changed_parameters,
+                ..event(node, stamp)
+            })
+            .collect()
+    }
+
+    /// The declaration burst of the node's start: rclcpp publishes one event per declared
+    /// parameter with it (and its initial value) in `new_parameters`.
+    pub fn declaration_events(
+        &self,
+        config: &Config,
+        node: &str,
+        stamp: Time,
+    ) -> Vec<ParameterEvent> {
+        self.all(config)
+            .into_iter()
+            .map(|(name, value)| ParameterEvent {
+                new_parameters: vec![Parameter { name, value }],
+                ..event(node, stamp)
+            })
+            .collect()
     }
 
     /// The server reporting `depth` as the node's `queue_depth`.
@@ -280,7 +326,9 @@ impl ParameterServer {
             (USE_SIM_TIME, Value::Bool(self.use_sim_time)),
             (MAP_FRAME, Value::String(f.map_frame.clone())),
             (BASE_FRAME, Value::String(f.base_frame.clone())),
+            (ODOM_FRAME, Value::String(f.odom_frame.clone())),
             (PUBLISH_TF, Value::Bool(f.publish_tf)),
+            (TF_MODE, Value::String(f.tf_mode.name().to_owned())),
             (QUEUE_DEPTH, Value::Number(self.queue_depth.into())),
             (
                 IMU_FRAME,
@@ -503,6 +551,9 @@ impl ParameterServer {
             .map(|p| {
                 let outcome = self.set_one(core, p);
                 self.log_outcome(p, &outcome);
+                if outcome.is_ok() {
+                    self.accepted.push(vec![p.clone()]);
+                }
                 result(outcome)
             })
             .collect();
@@ -547,6 +598,7 @@ impl ParameterServer {
         let outcome = outcome.and_then(|()| core.retune(config).map_err(|e| e.to_string()));
         if outcome.is_ok() {
             self.use_sim_time = sim_time;
+            self.accepted.push(params.to_vec());
         }
         for p in params.iter().take(MAX_NAMES) {
             self.log_outcome(p, &outcome);
@@ -661,7 +713,9 @@ mod tests {
                 "use_sim_time",
                 "map_frame",
                 "base_frame",
+                "odom_frame",
                 "publish_tf",
+                "tf_mode",
                 "queue_depth",
                 "imu_frame"
             ],
@@ -795,11 +849,69 @@ mod tests {
     }
 
     #[test]
+    fn accepted_sets_and_declarations_become_parameter_events() {
+        let mut s = ParameterServer::new(false, OutputFrames::default());
+        let mut core = RosAdapter::new(Config::default(), OutputFrames::default());
+        let stamp = Time {
+            sec: 1_764_000_000,
+            nanosec: 2_500_001,
+        };
+        let declared = s.declaration_events(core.engine().config(), "/ns/n", stamp);
+        assert_eq!(
+            declared.len(),
+            Config::default().parameters().len() + NODE_PARAMETERS.len()
+        );
+        assert!(declared.iter().all(|e| e.new_parameters.len() == 1
+            && e.changed_parameters.is_empty()
+            && e.node == "/ns/n"
+            && e.stamp == stamp));
+        assert!(s.take_events("/ns/n", stamp).is_empty(), "nothing set yet");
+        // One accepted, one refused (read-only): only the accepted one is announced.
+        let mask = param("gnss.elevation_mask_deg", double(12.5));
+        let variant = param("filter.variant", value(ParameterType::STRING));
+        let r = s.set(&mut core, &[mask, variant]);
+        assert!(r.results[0].successful && !r.results[1].successful);
+        let events = s.take_events("/ns/n", stamp);
+        assert_eq!(events.len(), 1);
+        let e = &events[0];
+        assert!(e.new_parameters.is_empty() && e.deleted_parameters.is_empty());
+        assert_eq!(e.changed_parameters.len(), 1);
+        assert_eq!(e.changed_parameters[0].name, "gnss.elevation_mask_deg");
+        assert_eq!(e.changed_parameters[0].value.double_value, 12.5);
+        assert!(s.take_events("/ns/n", stamp).is_empty(), "announced once");
+        // Two accepted in one set_parameters: two events, as rclcpp.
+        let two = [
+            param("gnss.elevation_mask_deg", double(11.0)),
+            param("gnss.cn0_mask_dbhz", double(22.0)),
+        ];
+        assert!(s.set(&mut core, &two).results.iter().all(|r| r.successful));
+        let events = s.take_events("/ns/n", stamp);
+        assert_eq!(events.len(), 2);
+        assert_eq!(events[1].changed_parameters[0].value.double_value, 22.0);
+        // An atomic set: all of it or, refused, nothing.
+        let both = [
+            param("gnss.elevation_mask_deg", double(15.0)),
+            param("gnss.cn0_mask_dbhz", double(20.0)),
+        ];
+        assert!(s.set_atomically(&mut core, &both).result.successful);
+        let events = s.take_events("/ns/n", stamp);
+        assert_eq!(events.len(), 1, "one event for the atomic set");
+        assert_eq!(events[0].changed_parameters.len(), 2);
+        let refused = [
+            both[0].clone(),
+            param("filter.joseph_form", value(ParameterType::BOOL)),
+        ];
+        assert!(!s.set_atomically(&mut core, &refused).result.successful);
+        assert!(s.take_events("/ns/n", stamp).is_empty());
+    }
+
+    #[test]
     fn frames_are_served_read_only() {
         let frames = OutputFrames {
             map_frame: "world_enu".to_owned(),
             base_frame: "imu_link".to_owned(),
             publish_tf: true,
+            ..OutputFrames::default()
         };
         let mut s = ParameterServer::new(false, frames);
         let mut core = RosAdapter::new(Config::default(), OutputFrames::default());

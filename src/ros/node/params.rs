@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use serde_yaml::Value;
 
 use crate::config::{manual::Row, Assignment, Config, ConfigError, Kind, MAX_FILE_BYTES};
-pub use crate::ros::adapter::OutputFrames;
+pub use crate::ros::adapter::{OutputFrames, TfMode};
 use crate::ros::args::{NodeArgs, ParameterSource, DEFAULT_NODE_NAME};
 use crate::ros::param_overrides::{node_matches, ParameterOverrides};
 
@@ -56,8 +56,13 @@ pub const USE_SIM_TIME: &str = "use_sim_time";
 pub const MAP_FRAME: &str = "map_frame";
 /// Frame of the vehicle body (FLU), the odometry's child frame and NavSatFix's frame.
 pub const BASE_FRAME: &str = "base_frame";
-/// Whether `map_frame` → `base_frame` is published on `/tf` with each Odometry.
+/// Parent of `base_frame` in the base controller's `/tf` (REP-105 `odom`), for
+/// [`TF_MODE`] `map_to_odom`.
+pub const ODOM_FRAME: &str = "odom_frame";
+/// Whether a TF is published on `/tf` with each Odometry (which one: [`TF_MODE`]).
 pub const PUBLISH_TF: &str = "publish_tf";
+/// Which TF is published with `publish_tf` ([`TfMode`]).
+pub const TF_MODE: &str = "tf_mode";
 /// Depth (messages) of the input subscriptions' and the publishers' history.
 pub const QUEUE_DEPTH: &str = "queue_depth";
 /// The `header.frame_id` of the IMU; empty: learnt from the stream.
@@ -108,10 +113,15 @@ pub const QUEUE_DEPTH_PARAMETER: NodeParameter = NodeParameter {
 
 /// The node's own parameters.
 ///
-/// Choice: the frames, the TF switch and the queue depth are fixed at start (read-only
-/// through the parameter services): a TF tree whose frames change while it runs would
-/// break its listeners, and the DDS entities are created with the depth.
-pub const NODE_PARAMETERS: [NodeParameter; 6] = [
+/// Choice: the frames, the TF switch and mode and the queue depth are fixed at start
+/// (read-only through the parameter services): a TF tree whose frames change while it
+/// runs would break its listeners, and the DDS entities are created with the depth.
+///
+/// Choice: `publish_tf` keeps its meaning (false, the default, publishes no TF) and
+/// `tf_mode` says which TF it publishes, `map_to_base_link` by default as before, so
+/// existing files and launch arguments behave as they did; `tf_mode: none` is a second
+/// way to switch the TF off, for a launch file that sets the mode alone.
+pub const NODE_PARAMETERS: [NodeParameter; 8] = [
     USE_SIM_TIME_PARAMETER,
     NodeParameter {
         name: MAP_FRAME,
@@ -130,12 +140,33 @@ pub const NODE_PARAMETERS: [NodeParameter; 6] = [
         doc: "Child frame of odometry and /tf, frame of fix: the vehicle body (FLU).",
     },
     NodeParameter {
+        name: ODOM_FRAME,
+        kind: Kind::Text,
+        default: "odom",
+        range: "a frame id (non-empty, no spaces), not map_frame or base_frame",
+        runtime: false,
+        doc: "With tf_mode map_to_odom: the parent of base_frame that the base \
+              controller publishes on /tf (REP-105 odom).",
+    },
+    NodeParameter {
         name: PUBLISH_TF,
         kind: Kind::Bool,
         default: "false",
         range: "true or false",
         runtime: false,
-        doc: "Publish map_frame -> base_frame on /tf with each odometry.",
+        doc: "Publish the TF of tf_mode on /tf with each odometry.",
+    },
+    NodeParameter {
+        name: TF_MODE,
+        kind: Kind::Text,
+        default: "map_to_base_link",
+        range: "map_to_base_link, map_to_odom or none",
+        runtime: false,
+        doc: "The TF published with publish_tf. map_to_base_link: map_frame -> \
+              base_frame, the fused pose. map_to_odom: map_frame -> odom_frame, so that \
+              it chained with the base controller's odom_frame -> base_frame (heard on \
+              /tf at the odometry stamp) gives the fused pose; none until that was heard \
+              (counted on /diagnostics). none: no TF. See docs/tf.md.",
     },
     QUEUE_DEPTH_PARAMETER,
     NodeParameter {
@@ -217,17 +248,32 @@ pub fn node_params_from(values: &[Assignment]) -> Result<NodeParams, ParamsError
     let frames = OutputFrames {
         map_frame: frame(value(MAP_FRAME), MAP_FRAME, &defaults.map_frame)?,
         base_frame: frame(value(BASE_FRAME), BASE_FRAME, &defaults.base_frame)?,
+        odom_frame: frame(value(ODOM_FRAME), ODOM_FRAME, &defaults.odom_frame)?,
         publish_tf: boolean(value(PUBLISH_TF), PUBLISH_TF, defaults.publish_tf)?,
+        tf_mode: tf_mode(value(TF_MODE))?,
     };
-    if frames.map_frame == frames.base_frame {
-        return Err(ParamsError::NodeParameter {
-            origin: value(BASE_FRAME)
+    let clash =
+        |name: &'static str, frame: &str, reason: &'static str| ParamsError::NodeParameter {
+            origin: value(name)
                 .or(value(MAP_FRAME))
                 .map_or_else(String::new, |a| a.origin.clone()),
-            name: BASE_FRAME,
-            value: frames.base_frame,
-            reason: "must differ from map_frame",
-        });
+            name,
+            value: frame.to_owned(),
+            reason,
+        };
+    if frames.map_frame == frames.base_frame {
+        return Err(clash(
+            BASE_FRAME,
+            &frames.base_frame,
+            "must differ from map_frame",
+        ));
+    }
+    if frames.odom_frame == frames.map_frame || frames.odom_frame == frames.base_frame {
+        return Err(clash(
+            ODOM_FRAME,
+            &frames.odom_frame,
+            "must differ from map_frame and base_frame",
+        ));
     }
     Ok(NodeParams {
         config,
@@ -278,6 +324,18 @@ pub(crate) fn frame(
             name,
             "must be a frame id (a non-empty string without spaces)",
         )),
+    }
+}
+
+/// A [`TfMode`] by its name; unset: `map_to_base_link`.
+fn tf_mode(a: Option<&Assignment>) -> Result<TfMode, ParamsError> {
+    match a {
+        None => Ok(TfMode::MapToBaseLink),
+        Some(a) => a
+            .value
+            .as_str()
+            .and_then(TfMode::from_name)
+            .ok_or_else(|| refused(a, TF_MODE, "must be map_to_base_link, map_to_odom or none")),
     }
 }
 
@@ -546,7 +604,9 @@ mod tests {
             (USE_SIM_TIME, Value::Bool(p.use_sim_time)),
             (MAP_FRAME, p.frames.map_frame.into()),
             (BASE_FRAME, p.frames.base_frame.into()),
+            (ODOM_FRAME, p.frames.odom_frame.into()),
             (PUBLISH_TF, Value::Bool(p.frames.publish_tf)),
+            (TF_MODE, p.frames.tf_mode.name().into()),
             (QUEUE_DEPTH, Value::from(p.queue_depth)),
             (IMU_FRAME, p.imu_frame.unwrap_or_default().into()),
         ];
@@ -607,11 +667,30 @@ mod tests {
         assert!(p.frames.publish_tf);
         let p = load_with(&[&file], &["-p", "publish_tf:=false"]).unwrap();
         assert!(!p.frames.publish_tf, "-p wins over the file");
+        assert_eq!(
+            p.frames.published_tf(),
+            TfMode::None,
+            "publish_tf false: none"
+        );
+        let p = load_with(&[&file], &["-p", "tf_mode:=map_to_odom"]).unwrap();
+        assert_eq!(p.frames.published_tf(), TfMode::MapToOdom);
+        assert_eq!(p.frames.odom_frame, "odom");
+        let p = load_with(
+            &[&file],
+            &["-p", "tf_mode:=none", "-p", "odom_frame:=wheel_odom"],
+        )
+        .unwrap();
+        assert_eq!(p.frames.published_tf(), TfMode::None);
+        assert_eq!(p.frames.odom_frame, "wheel_odom");
         for bad in [
             "publish_tf:=yes please",
             "base_frame:=''",
             "map_frame:=12",
             "base_frame:=map",
+            "odom_frame:=base_link",
+            "odom_frame:=map",
+            "tf_mode:=map_to_odometry",
+            "tf_mode:=1",
         ] {
             let e = load_with(&[FILE], &["-p", bad]);
             assert!(

@@ -1,0 +1,342 @@
+//! `tf_mode` `map_to_odom` over DDS (issue 16, items 2 and 7): a stand-in base controller
+//! publishes `odom → base_link` on `/tf` at 50 Hz with a moving drift, while the node runs
+//! on a simulated static receiver; the node's `map → odom` composed with the controller's
+//! `odom → base_link` of the same stamp must be the node's Odometry pose, and the node
+//! must never publish a parent of `base_link` (base_link keeps the controller's `odom`).
+//!
+//! DDS traffic stays on this machine: the test re-executes itself inside a private
+//! network namespace that has only loopback (tests/netns_support).
+
+mod netns_support;
+
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use adaptive_gnss_ins::ros::convert::seconds_to_time;
+use adaptive_gnss_ins::ros::msg::{
+    DiagnosticArray, GnssMeasurements, Header, Imu, Odometry, Quaternion, RosMessage, TFMessage,
+    Time, TransformStamped, Vector3,
+};
+use adaptive_gnss_ins::ros::outbound;
+use adaptive_gnss_ins::sim::{Scenario, SimEvent};
+use nalgebra::{Isometry3, Translation3, UnitQuaternion};
+use netns_support::{reexec_in_private_netns, KillOnDrop};
+use ros2_client::{
+    Context, ContextOptions, MessageTypeName, Name, NodeName, NodeOptions, QosProfile,
+};
+
+const DOMAIN_ID: u16 = 19;
+/// Scenario seconds streamed, and how much faster than real time.
+const STREAM_S: f64 = 20.0;
+const SPEED_UP: f64 = 10.0;
+/// The base controller's period: 50 Hz.
+const CONTROLLER_PERIOD_NS: i64 = 20_000_000;
+/// How far (scenario time) the controller's `/tf` runs ahead of the IMU, so that every
+/// Odometry stamp lies between two controller stamps the node has heard: 0.2 s are 20 ms
+/// of wall time at 10x, against sub-millisecond loopback latencies.
+const CONTROLLER_LEAD_NS: i64 = 200_000_000;
+/// Choice of tolerance: the node interpolates between two controller stamps exactly as
+/// the drift moves (linear translation, constant yaw rate: slerp is exact), and CDR
+/// carries f64 unchanged, so what is left is the rounding of products of 10 m-scale
+/// poses (~1e-14 m). 1e-12 m and rad catch a transform held one controller period
+/// (0.5 m/s × 20 ms = 1 cm), a wrong composition order, and an interpolated rotation
+/// left unnormalized (1.1e-9 m, measured here before the adapter renormalized it).
+const TOLERANCE: f64 = 1e-12;
+
+fn type_name<M: RosMessage>() -> MessageTypeName {
+    let parts: Vec<&str> = M::TYPE_NAME.split('/').collect();
+    MessageTypeName::new(parts[0], parts[2])
+}
+
+fn nanos(t: &Time) -> i64 {
+    i64::from(t.sec) * 1_000_000_000 + i64::from(t.nanosec)
+}
+
+fn time(ns: i64) -> Time {
+    Time {
+        sec: ns.div_euclid(1_000_000_000) as i32,
+        nanosec: ns.rem_euclid(1_000_000_000) as u32,
+    }
+}
+
+/// The wheel odometry's `odom → base_link` at `ns`: drifting 0.5 m/s east, 0.1 m/s north
+/// and 0.05 rad/s of yaw from `start_ns`.
+fn drift(ns: i64, start_ns: i64) -> Isometry3<f64> {
+    let t_s = (ns - start_ns) as f64 * 1e-9;
+    Isometry3::from_parts(
+        Translation3::new(0.5 * t_s, 0.1 * t_s, 0.0),
+        UnitQuaternion::from_euler_angles(0.0, 0.0, 0.05 * t_s),
+    )
+}
+
+fn controller_tf(ns: i64, pose: &Isometry3<f64>) -> TFMessage {
+    let header = Header {
+        stamp: time(ns),
+        frame_id: "odom".to_owned(),
+    };
+    TFMessage {
+        transforms: vec![outbound::transform_stamped(header, "base_link", pose)],
+    }
+}
+
+fn isometry(t: &Vector3, q: &Quaternion) -> Isometry3<f64> {
+    Isometry3::from_parts(
+        Translation3::new(t.x, t.y, t.z),
+        UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(q.w, q.x, q.y, q.z)),
+    )
+}
+
+fn odometry_pose(o: &Odometry) -> Isometry3<f64> {
+    let p = &o.pose.pose.position;
+    isometry(
+        &Vector3 {
+            x: p.x,
+            y: p.y,
+            z: p.z,
+        },
+        &o.pose.pose.orientation,
+    )
+}
+
+#[test]
+fn map_to_odom_chained_with_the_controllers_odom_is_the_fused_pose() {
+    if reexec_in_private_netns("map_to_odom_chained_with_the_controllers_odom_is_the_fused_pose") {
+        return;
+    }
+    let scenario = Scenario::builtin("static", 3).unwrap();
+    let spec = &scenario.spec().trajectory;
+    let params = concat!(env!("CARGO_MANIFEST_DIR"), "/params/ekf.yaml");
+    let datum = format!(
+        "output.datum_llh_deg_m:=[{}, {}, {}]",
+        spec.start_lat_deg, spec.start_lon_deg, spec.start_height_m
+    );
+    let node = Command::new(env!("CARGO_BIN_EXE_gnss_ins_node"))
+        .args(["--ros-args", "--params-file", params])
+        .args(["-p", "init.heading_deg:=0.0", "-p", &datum])
+        .args(["-r", "__ns:=/test"])
+        .args(["-p", "publish_tf:=true", "-p", "tf_mode:=map_to_odom"])
+        .args(["-p", "queue_depth:=500"])
+        .env("ROS_DOMAIN_ID", DOMAIN_ID.to_string())
+        .env("RUST_LOG", "info,rustdds=error,ros2_client=warn")
+        .stdin(Stdio::null())
+        .spawn()
+        .unwrap();
+    let _node = KillOnDrop(node);
+
+    let context = Context::with_options(ContextOptions::new().domain_id(DOMAIN_ID)).unwrap();
+    let mut peer = context
+        .new_node(
+            NodeName::new("/test", "base_controller").unwrap(),
+            NodeOptions::new()
+                .enable_rosout(false)
+                .start_parameter_services(false),
+        )
+        .unwrap();
+    let reliable = QosProfile::publisher_default()
+        .history(ros2_client::qos::History::KeepLast { depth: 20_000 });
+    let topic = |peer: &mut ros2_client::Node, name: &str, t: MessageTypeName| {
+        peer.create_topic(&Name::parse(name).unwrap(), t, &reliable)
+            .unwrap()
+    };
+    let imu_topic = topic(&mut peer, "/test/imu", type_name::<Imu>());
+    let gnss_topic = topic(
+        &mut peer,
+        "/test/gnss/measurements",
+        type_name::<GnssMeasurements>(),
+    );
+    let odom_topic = topic(&mut peer, "/test/odometry", type_name::<Odometry>());
+    let diag_topic = topic(&mut peer, "/diagnostics", type_name::<DiagnosticArray>());
+    let tf_topic = topic(&mut peer, "/tf", type_name::<TFMessage>());
+    let imu_pub = peer.create_publisher::<Imu>(&imu_topic, None).unwrap();
+    let gnss_pub = peer
+        .create_publisher::<GnssMeasurements>(&gnss_topic, None)
+        .unwrap();
+    let tf_pub = peer.create_publisher::<TFMessage>(&tf_topic, None).unwrap();
+    let odom_sub = peer
+        .create_subscription::<Odometry>(&odom_topic, None)
+        .unwrap();
+    let diag_sub = peer
+        .create_subscription::<DiagnosticArray>(&diag_topic, None)
+        .unwrap();
+    let tf_sub = peer
+        .create_subscription::<TFMessage>(&tf_topic, None)
+        .unwrap();
+    let spinner = peer.spinner().unwrap();
+    std::thread::spawn(move || smol::block_on(spinner.spin()));
+
+    let matched = smol::block_on(async {
+        let wait = async {
+            imu_pub.wait_for_subscription(&peer).await;
+            gnss_pub.wait_for_subscription(&peer).await;
+            tf_pub.wait_for_subscription(&peer).await;
+            odom_sub.wait_for_publisher(&peer).await;
+            true
+        };
+        futures::select! {
+            ok = futures::FutureExt::fuse(wait) => ok,
+            _ = futures::FutureExt::fuse(smol::Timer::after(Duration::from_secs(20))) => false,
+        }
+    });
+    assert!(matched, "the node's topics were not discovered within 20 s");
+
+    let first_imu_ns = scenario
+        .events()
+        .map(Result::unwrap)
+        .find_map(|e| match e {
+            SimEvent::Imu(s) => Some(nanos(&seconds_to_time(s.t_s).unwrap())),
+            _ => None,
+        })
+        .unwrap();
+    // Our side having matched does not mean the node's best-effort readers have matched
+    // our writers: repeat the controller's first transform and an empty GNSS epoch until
+    // the node's diagnostics count both.
+    let key_value = |d: &DiagnosticArray, key: &str| {
+        d.status[0]
+            .values
+            .iter()
+            .find(|kv| kv.key == key)
+            .and_then(|kv| kv.value.parse::<u64>().ok())
+    };
+    let deadline = Instant::now() + Duration::from_secs(20);
+    let (mut tf_heard, mut gnss_heard) = (0, 0);
+    while tf_heard == 0 || gnss_heard == 0 {
+        assert!(
+            Instant::now() < deadline,
+            "the node never reported the controller's transform and the empty epoch"
+        );
+        let first = controller_tf(first_imu_ns, &drift(first_imu_ns, first_imu_ns));
+        tf_pub.publish(first).unwrap();
+        gnss_pub.publish(GnssMeasurements::default()).unwrap();
+        std::thread::sleep(Duration::from_millis(250));
+        while let Ok(Some((d, _))) = diag_sub.take() {
+            tf_heard = key_value(&d, "odom_tf_received").unwrap_or(0);
+            gnss_heard = key_value(&d, "gnss_received").unwrap_or(0);
+        }
+    }
+
+    // Stream the scenario, the controller's /tf running CONTROLLER_LEAD_NS ahead.
+    let start = Instant::now();
+    let mut next_tf_ns = first_imu_ns + CONTROLLER_PERIOD_NS;
+    let mut controller_sent = 0u64;
+    for event in scenario.events() {
+        let event = event.unwrap();
+        let t_s = event.t_s();
+        if t_s > STREAM_S {
+            break;
+        }
+        let due = Duration::from_secs_f64(t_s / SPEED_UP);
+        if let Some(wait) = due.checked_sub(start.elapsed()) {
+            std::thread::sleep(wait);
+        }
+        let stamp = seconds_to_time(t_s).unwrap();
+        while next_tf_ns <= nanos(&stamp) + CONTROLLER_LEAD_NS {
+            let tf = controller_tf(next_tf_ns, &drift(next_tf_ns, first_imu_ns));
+            tf_pub.publish(tf).unwrap();
+            controller_sent += 1;
+            next_tf_ns += CONTROLLER_PERIOD_NS;
+        }
+        match event {
+            SimEvent::Imu(s) => imu_pub
+                .publish(outbound::imu(&s, stamp, "imu_link"))
+                .unwrap(),
+            SimEvent::Gnss { epoch, .. } => gnss_pub
+                .publish(outbound::gnss_measurements(&epoch, 0, stamp, "gnss"))
+                .unwrap(),
+            _ => {}
+        }
+    }
+
+    let deadline = Instant::now() + Duration::from_secs(3);
+    let mut odometry = Vec::new();
+    let mut transforms = Vec::new();
+    let mut last_diagnostics = None;
+    while Instant::now() < deadline {
+        while let Ok(Some((o, _))) = odom_sub.take() {
+            odometry.push(o);
+        }
+        while let Ok(Some((t, _))) = tf_sub.take() {
+            transforms.extend(t.transforms);
+        }
+        while let Ok(Some((d, _))) = diag_sub.take() {
+            last_diagnostics = Some(d);
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+
+    // base_link has one parent: the controller's odom. Everything else on /tf is the
+    // node's map -> odom.
+    for t in &transforms {
+        if t.child_frame_id == "base_link" {
+            assert_eq!(
+                t.header.frame_id, "odom",
+                "a second parent of base_link: {t:?}"
+            );
+        } else {
+            assert_eq!(
+                (t.header.frame_id.as_str(), t.child_frame_id.as_str()),
+                ("map", "odom"),
+                "{t:?}"
+            );
+        }
+    }
+    let map_to_odom: std::collections::HashMap<i64, &TransformStamped> = transforms
+        .iter()
+        .filter(|t| t.child_frame_id == "odom")
+        .map(|t| (nanos(&t.header.stamp), t))
+        .collect();
+    // One Odometry per IMU sample from the initialization at 1 s: about 1900.
+    assert!(
+        odometry.len() > 1500,
+        "only {} Odometry messages received",
+        odometry.len()
+    );
+    let (mut matched, mut worst_m, mut worst_rad) = (0, 0.0f64, 0.0f64);
+    for o in &odometry {
+        assert_eq!(
+            (o.header.frame_id.as_str(), o.child_frame_id.as_str()),
+            ("map", "base_link"),
+            "the Odometry keeps its REP-105 meaning"
+        );
+        let ns = nanos(&o.header.stamp);
+        let Some(t) = map_to_odom.get(&ns) else {
+            continue;
+        };
+        let map_odom = isometry(&t.transform.translation, &t.transform.rotation);
+        let chained = map_odom * drift(ns, first_imu_ns);
+        let d = chained.inverse() * odometry_pose(o);
+        worst_m = worst_m.max(d.translation.vector.norm());
+        worst_rad = worst_rad.max(d.rotation.angle());
+        matched += 1;
+    }
+    eprintln!(
+        "{} Odometry, {} map -> odom, {matched} matched, {controller_sent} controller \
+         transforms sent; largest chain error {worst_m:.3e} m, {worst_rad:.3e} rad",
+        odometry.len(),
+        map_to_odom.len()
+    );
+    assert!(
+        matched * 100 >= odometry.len() * 99,
+        "{matched} of {} Odometry messages have a map -> odom at their stamp",
+        odometry.len()
+    );
+    assert!(
+        worst_m < TOLERANCE && worst_rad < TOLERANCE,
+        "map -> odom -> base_link differs from the Odometry by {worst_m} m, {worst_rad} rad"
+    );
+    // The drift moved odom away from map: the node did not just publish the identity.
+    let last = odometry.last().unwrap();
+    let last_map_odom = map_to_odom[&nanos(&last.header.stamp)];
+    let offset = &last_map_odom.transform.translation;
+    assert!(offset.x.hypot(offset.y) > 5.0, "map -> odom {offset:?}");
+
+    let diagnostics = last_diagnostics.expect("no /diagnostics received");
+    let value = |key: &str| key_value(&diagnostics, key);
+    eprintln!("diagnostics: {:?}", diagnostics.status[0].values);
+    assert!(value("odom_tf_received").unwrap() >= controller_sent);
+    assert_eq!(value("odom_tf_unusable"), Some(0));
+    assert_eq!(
+        value("map_to_odom_missing"),
+        Some(0),
+        "every Odometry had a controller transform around its stamp"
+    );
+}
