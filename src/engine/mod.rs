@@ -26,9 +26,13 @@
 //!   ([`heading_bank`]), and nothing is published until it has decided.
 //! - IMU samples are screened first ([`imu_screen`]): one beyond the sensor's range or a
 //!   lone spike is dropped and counted, and the strapdown step spans it.
+//! - Each GNSS input seen for the first time feeds the divergence monitor ([`divergence`],
+//!   [`recovery`]) with the prior's disagreement with an independent GNSS position; a
+//!   sustained one resets the filter, which starts again from GNSS, and is counted.
 
 mod adaptation;
 pub mod adaptive_noise;
+pub mod divergence;
 mod filter_state;
 mod fix_track;
 pub mod heading_bank;
@@ -36,6 +40,7 @@ pub mod imu_screen;
 mod initializer;
 mod output;
 pub mod q_scaling;
+mod recovery;
 mod rejection;
 mod retune;
 pub mod standstill;
@@ -49,6 +54,7 @@ use crate::filter::process_model::ProcessNoise;
 use crate::gnss::GnssEpoch;
 use crate::ins::ImuSample;
 
+use divergence::DivergenceMonitor;
 use heading_bank::HeadingBank;
 use imu_screen::{ImuScreen, Screened};
 use standstill::StandstillDetector;
@@ -155,6 +161,12 @@ pub struct Engine {
     screen: ImuScreen,
     /// The recent body-frame samples, for the start-up's tests of rest and motion.
     standstill: StandstillDetector,
+    /// The filter against independent GNSS positions.
+    monitor: DivergenceMonitor,
+    /// Resets after a divergence so far.
+    divergence_resets: u64,
+    /// Time of the last divergence while the filter has not started again since.
+    diverged_at_t_s: Option<f64>,
 }
 
 impl Engine {
@@ -173,6 +185,9 @@ impl Engine {
             counters: RejectionCounters::default(),
             replaying: false,
             screen: ImuScreen::default(),
+            monitor: DivergenceMonitor::default(),
+            divergence_resets: 0,
+            diverged_at_t_s: None,
         }
     }
 
@@ -183,6 +198,17 @@ impl Engine {
     /// Inputs rejected so far, by reason.
     pub fn counters(&self) -> &RejectionCounters {
         &self.counters
+    }
+
+    /// Resets after a divergence from GNSS so far.
+    pub fn divergence_resets(&self) -> u64 {
+        self.divergence_resets
+    }
+
+    /// Time of the divergence the engine is recovering from: set by a divergence reset,
+    /// None again once the filter runs.
+    pub fn diverged_at_t_s(&self) -> Option<f64> {
+        self.diverged_at_t_s
     }
 
     /// The running filter state, or None while initializing.
@@ -240,6 +266,7 @@ impl Engine {
         };
         self.phase = Phase::Initializing(init);
         self.adaptation.reset();
+        self.monitor.clear();
         self.imu.clear();
         self.history.clear();
         self.pending.clear();
@@ -524,7 +551,9 @@ impl Engine {
                 match result {
                     Ok(epoch) if state.is_finite() => {
                         if report {
+                            let reset = self.monitor_divergence(&before, &p.measurement, &epoch);
                             out.push(Output::Epoch(epoch));
+                            out.extend(reset);
                         }
                     }
                     Ok(_) | Err(_) => {
