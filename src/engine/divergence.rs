@@ -11,15 +11,24 @@
 //!   combined σ (the Mahalanobis distance with the filter's position covariance plus the
 //!   GNSS position's own), and
 //! - the GNSS positions are consistent with each other: each epoch's offset (GNSS less
-//!   filter) differs from the previous one by less than half its length, so the GNSS
-//!   sees the same wrong state epoch after epoch. An outlier fix changes the offset by its
-//!   own size and breaks the run, whatever its size; a filter pulled by an outlier is
-//!   within a few σ of the following fixes.
+//!   filter) points within [`MAX_TURN_RAD`] of the previous one's, so the GNSS sees the
+//!   filter off the same way epoch after epoch. Outlier fixes point anywhere and break the
+//!   run, whatever their size; a filter pulled by an outlier is within a few σ of the
+//!   following fixes. The lengths are not compared: a filter that diverged takes large
+//!   corrections (an EKF jumps most of the way to the first fix after a fault and is then
+//!   off by its velocity error), so its offset shrinks or grows by far more than the
+//!   GNSS's σ from one epoch to the next.
 //!
 //! A wrong filter and the GNSS agreeing on that are what divergence is; one epoch that
 //! cannot be judged (no independent position) ends the run.
 
 use nalgebra::{Matrix3, Vector3};
+
+use super::filter_state::FilterState;
+use super::output::position_covariance_enu_m2;
+use crate::config::Config;
+use crate::earth::{self, Llh};
+use crate::filter::measurement_rows::AntennaGeometry;
 
 /// Mahalanobis distance beyond which an epoch disagrees (σ of the combined covariance).
 ///
@@ -33,6 +42,8 @@ pub const DISAGREE_SIGMA: f64 = 5.0;
 pub const MIN_SPAN_S: f64 = 3.0;
 /// Fewest disagreeing epochs that are divergence.
 pub const MIN_EPOCHS: u32 = 4;
+/// Largest angle between the offsets of consecutive epochs of one run (rad). Choice: 60°.
+pub const MAX_TURN_RAD: f64 = std::f64::consts::FRAC_PI_3;
 /// Longest time between two epochs of one run (s): an outage ends it.
 pub const MAX_EPOCH_GAP_S: f64 = 2.0;
 
@@ -47,6 +58,30 @@ pub struct Disagreement {
 }
 
 impl Disagreement {
+    /// The filter's disagreement with the GNSS antenna position `gnss` of covariance
+    /// `gnss_covariance_enu_m2`.
+    ///
+    /// Choice: the filter's covariance is that of its IMU position; the lever arm's share
+    /// through the attitude error (centimetres for a lever of a metre) is left out.
+    pub fn of(
+        prior: &FilterState,
+        gnss: &Llh,
+        gnss_covariance_enu_m2: &Matrix3<f64>,
+        config: &Config,
+    ) -> Self {
+        // The body rate moves only the antenna's velocity, not its position.
+        let no_rate = Vector3::zeros();
+        let geo = AntennaGeometry::new(&prior.nav, &config.mounting.lever_arm_b_m, &no_rate);
+        let rot = earth::rot_ecef_to_enu(&prior.nav.p);
+        let antenna_ecef_m = geo.antenna_ecef_m(&prior.nav.p);
+        Self {
+            t_s: prior.nav.t_s,
+            offset_enu_m: rot * (earth::llh_to_ecef(gnss) - antenna_ecef_m),
+            covariance_enu_m2: position_covariance_enu_m2(&prior.nav.p, &prior.p)
+                + gnss_covariance_enu_m2,
+        }
+    }
+
     /// The Mahalanobis distance of the offset (σ); None when the covariance is not
     /// positive definite.
     pub fn sigmas(&self) -> Option<f64> {
@@ -81,7 +116,7 @@ impl DivergenceMonitor {
         };
         let continues = self.run.filter(|run| {
             d.t_s - run.last_t_s <= MAX_EPOCH_GAP_S
-                && (d.offset_enu_m - run.last_offset_enu_m).norm() < 0.5 * d.offset_enu_m.norm()
+                && d.offset_enu_m.angle(&run.last_offset_enu_m) <= MAX_TURN_RAD
         });
         let run = match continues {
             Some(run) => Run {
@@ -131,10 +166,12 @@ mod tests {
     #[test]
     fn outliers_gaps_and_unjudged_epochs_end_the_run() {
         let mut monitor = DivergenceMonitor::default();
-        // Outliers of alternating size: the GNSS is not consistent with itself.
+        // Outliers in turning directions: the GNSS is not consistent with itself.
         for k in 0..10 {
-            let east_m = if k % 2 == 0 { 30.0 } else { 8.0 };
-            assert!(!monitor.check(Some(&epoch(f64::from(k), east_m))));
+            let mut outlier = epoch(f64::from(k), 0.0);
+            let turn_rad = f64::from(k) * 1.2;
+            outlier.offset_enu_m = Vector3::new(turn_rad.cos(), turn_rad.sin(), 0.0) * 30.0;
+            assert!(!monitor.check(Some(&outlier)));
         }
         // Within 5σ: no run.
         for k in 10..20 {

@@ -6,12 +6,11 @@ use nalgebra::Matrix3;
 
 use super::divergence::Disagreement;
 use super::filter_state::FilterState;
-use super::output::{position_covariance_enu_m2, EpochReport, SatRejection};
+use super::output::{EpochReport, SatRejection};
 use super::update::{position_covariance, sigma_model};
 use super::{initializer, Engine, Initializer, Measurement, Output, Phase, ResetReason};
 use crate::config::Config;
 use crate::earth::{self, Llh};
-use crate::filter::measurement_rows::AntennaGeometry;
 use crate::gnss::spp::{self, SppConfig};
 use crate::gnss::GnssEpoch;
 
@@ -38,7 +37,7 @@ impl Engine {
             Measurement::Gnss(e) => single_point_if_gated(e, report, prior, &self.config),
         };
         let disagreement = gnss.map(|(position, covariance_enu_m2)| {
-            disagreement(prior, &position, &covariance_enu_m2, &self.config)
+            Disagreement::of(prior, &position, &covariance_enu_m2, &self.config)
         });
         if !self.monitor.check(disagreement.as_ref()) {
             return None;
@@ -57,29 +56,6 @@ impl Engine {
         // from GNSS, in motion if need be.
         self.phase = Phase::Initializing(Box::<Initializer>::default());
         Some(reset)
-    }
-}
-
-/// The filter's disagreement with the GNSS antenna position `gnss` of covariance
-/// `gnss_covariance_enu_m2`.
-///
-/// Choice: the filter's covariance is that of its IMU position; the lever arm's share
-/// through the attitude error (centimetres for a lever of a metre) is left out.
-pub fn disagreement(
-    prior: &FilterState,
-    gnss: &Llh,
-    gnss_covariance_enu_m2: &Matrix3<f64>,
-    config: &Config,
-) -> Disagreement {
-    let w = prior.compensate(&prior.last_imu).w_ib_b_rad_s;
-    let geo = AntennaGeometry::new(&prior.nav, &config.mounting.lever_arm_b_m, &w);
-    let rot = earth::rot_ecef_to_enu(&prior.nav.p);
-    let antenna_ecef_m = geo.antenna_ecef_m(&prior.nav.p);
-    Disagreement {
-        t_s: prior.nav.t_s,
-        offset_enu_m: rot * (earth::llh_to_ecef(gnss) - antenna_ecef_m),
-        covariance_enu_m2: position_covariance_enu_m2(&prior.nav.p, &prior.p)
-            + gnss_covariance_enu_m2,
     }
 }
 
