@@ -19,8 +19,20 @@
 //!   off by its velocity error), so its offset shrinks or grows by far more than the
 //!   GNSS's σ from one epoch to the next.
 //!
+//! - the disagreement did not appear as a GNSS jump: an offset that leaps beyond
+//!   [`DISAGREE_SIGMA`] between two consecutive epochs (at most [`MAX_EPOCH_GAP_S`] apart)
+//!   from an epoch that agreed is the GNSS moving, not the filter — the IMU cannot carry
+//!   the state that far beyond its own σ in a second, and a filter that drifts crosses
+//!   5σ in small steps. Such a disagreement (fixes biased by NLOS reception in a street
+//!   canyon, confidently wrong for a hundred seconds in tests/consumer_mems_drive.rs)
+//!   starts no run until an epoch agrees again. After an outage there is no epoch before
+//!   to compare with, and the drift of the outage is judged as above.
+//!
 //! A wrong filter and the GNSS agreeing on that are what divergence is; one epoch that
-//! cannot be judged (no independent position) ends the run.
+//! cannot be judged (no independent position) ends the run. Limits: a filter that jumps
+//! within a second (an IMU fault the screening lets through, a second after a GNSS
+//! epoch) is taken for a GNSS jump; a GNSS that is confidently wrong from the first epoch
+//! after an outage is taken for the truth.
 
 use nalgebra::{Matrix3, Vector3};
 
@@ -100,20 +112,57 @@ struct Run {
     epochs: u32,
 }
 
+/// The epoch before: its time, its offset if it was judged, and whether it disagreed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Previous {
+    t_s: f64,
+    offset_enu_m: Option<Vector3<f64>>,
+    disagreed: bool,
+}
+
 /// See the module documentation.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct DivergenceMonitor {
     run: Option<Run>,
+    previous: Option<Previous>,
+    /// The current disagreement began with a GNSS jump: no run until an epoch agrees.
+    gnss_jumped: bool,
 }
 
 impl DivergenceMonitor {
-    /// Takes one epoch's disagreement (None: no independent position at this epoch);
-    /// true when the filter has diverged.
-    pub fn check(&mut self, epoch: Option<&Disagreement>) -> bool {
-        let Some(d) = epoch.filter(|d| d.sigmas().is_some_and(|s| s > DISAGREE_SIGMA)) else {
+    /// Takes the GNSS epoch at `t_s` and its disagreement (None: no independent position
+    /// at this epoch, as in tight coupling when the gate kept most pseudo-ranges); true
+    /// when the filter has diverged.
+    pub fn check(&mut self, t_s: f64, epoch: Option<&Disagreement>) -> bool {
+        let judged = epoch.and_then(|d| Some((d, d.sigmas()?)));
+        let disagreeing = judged.filter(|(_, s)| *s > DISAGREE_SIGMA).map(|(d, _)| d);
+        let previous = self.previous.filter(|p| t_s - p.t_s <= MAX_EPOCH_GAP_S);
+        self.previous = Some(Previous {
+            t_s,
+            offset_enu_m: judged.map(|(d, _)| d.offset_enu_m),
+            disagreed: disagreeing.is_some(),
+        });
+        let Some(d) = disagreeing else {
             self.run = None;
+            self.gnss_jumped = false;
             return false;
         };
+        if let Some(Previous {
+            offset_enu_m: Some(before),
+            disagreed: false,
+            ..
+        }) = previous
+        {
+            let step = Disagreement {
+                offset_enu_m: d.offset_enu_m - before,
+                ..*d
+            };
+            self.gnss_jumped |= step.sigmas().is_some_and(|s| s > DISAGREE_SIGMA);
+        }
+        if self.gnss_jumped {
+            self.run = None;
+            return false;
+        }
         let continues = self.run.filter(|run| {
             d.t_s - run.last_t_s <= MAX_EPOCH_GAP_S
                 && d.offset_enu_m.angle(&run.last_offset_enu_m) <= MAX_TURN_RAD
@@ -136,9 +185,9 @@ impl DivergenceMonitor {
         run.epochs >= MIN_EPOCHS && run.last_t_s - run.first_t_s >= MIN_SPAN_S
     }
 
-    /// Forgets the run (after a reset).
+    /// Forgets everything (after a reset).
     pub fn clear(&mut self) {
-        self.run = None;
+        *self = Self::default();
     }
 }
 
@@ -154,41 +203,58 @@ mod tests {
         }
     }
 
-    #[test]
-    fn a_sustained_consistent_disagreement_is_divergence() {
-        let mut monitor = DivergenceMonitor::default();
-        let verdicts: Vec<bool> = (0..5)
-            .map(|k| monitor.check(Some(&epoch(f64::from(k), 500.0 + f64::from(k)))))
-            .collect();
-        assert_eq!(verdicts, [false, false, false, true, true]);
+    fn check(monitor: &mut DivergenceMonitor, t_s: f64, east_m: f64) -> bool {
+        monitor.check(t_s, Some(&epoch(t_s, east_m)))
     }
 
     #[test]
-    fn outliers_gaps_and_unjudged_epochs_end_the_run() {
+    fn a_sustained_consistent_disagreement_is_divergence() {
+        let mut monitor = DivergenceMonitor::default();
+        // The first epoch after an outage, 500 m off, and on.
+        let verdicts: Vec<bool> = (0..5)
+            .map(|k| check(&mut monitor, f64::from(k), 500.0 + f64::from(k)))
+            .collect();
+        assert_eq!(verdicts, [false, false, false, true, true]);
+        // A filter drifting off in small steps from agreement.
+        let mut monitor = DivergenceMonitor::default();
+        let verdicts: Vec<bool> = [0.0, 4.0, 5.5, 7.0, 8.5, 10.0]
+            .into_iter()
+            .enumerate()
+            .map(|(k, east_m)| check(&mut monitor, k as f64, east_m))
+            .collect();
+        assert_eq!(verdicts, [false, false, false, false, false, true]);
+    }
+
+    #[test]
+    fn outliers_jumps_gaps_and_unjudged_epochs_start_no_divergence() {
         let mut monitor = DivergenceMonitor::default();
         // Outliers in turning directions: the GNSS is not consistent with itself.
         for k in 0..10 {
-            let mut outlier = epoch(f64::from(k), 0.0);
-            let turn_rad = f64::from(k) * 1.2;
+            let t_s = f64::from(k);
+            let mut outlier = epoch(t_s, 0.0);
+            let turn_rad = t_s * 1.2;
             outlier.offset_enu_m = Vector3::new(turn_rad.cos(), turn_rad.sin(), 0.0) * 30.0;
-            assert!(!monitor.check(Some(&outlier)));
+            assert!(!monitor.check(t_s, Some(&outlier)));
         }
-        // Within 5σ: no run.
-        for k in 10..20 {
-            assert!(!monitor.check(Some(&epoch(f64::from(k), 4.9))));
+        // Within 5σ, then the GNSS jumps 45 σ away and stays there: no divergence.
+        for k in 10..40 {
+            let east_m = if k < 20 { 4.9 } else { 50.0 };
+            assert!(!check(&mut monitor, f64::from(k), east_m));
         }
-        // A gap (an outage) and an epoch without an independent position restart it.
-        for t in [20.0, 21.0, 22.0, 25.0, 26.0, 27.0] {
-            assert!(!monitor.check(Some(&epoch(t, 50.0))));
+        // An outage (a gap) restarts the run.
+        let mut monitor = DivergenceMonitor::default();
+        for t_s in [40.0, 41.0, 42.0, 45.0, 46.0, 47.0] {
+            assert!(!check(&mut monitor, t_s, 50.0));
         }
-        assert!(!monitor.check(None));
-        for t in [29.0, 30.0, 31.0] {
-            assert!(!monitor.check(Some(&epoch(t, 50.0))));
+        // So does an epoch without an independent position, and it shows no jump.
+        assert!(!monitor.check(48.0, None));
+        for t_s in [49.0, 50.0, 51.0] {
+            assert!(!check(&mut monitor, t_s, 50.0));
         }
-        assert!(monitor.check(Some(&epoch(32.0, 50.0))));
+        assert!(check(&mut monitor, 52.0, 50.0));
         // A covariance that is no covariance judges nothing.
-        let mut broken = epoch(33.0, 50.0);
+        let mut broken = epoch(53.0, 50.0);
         broken.covariance_enu_m2 = -Matrix3::identity();
-        assert!(!monitor.check(Some(&broken)));
+        assert!(!monitor.check(53.0, Some(&broken)));
     }
 }

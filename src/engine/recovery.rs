@@ -8,7 +8,7 @@ use super::divergence::Disagreement;
 use super::filter_state::FilterState;
 use super::output::{EpochReport, SatRejection};
 use super::update::{position_covariance, sigma_model};
-use super::{initializer, Engine, Initializer, Measurement, Output, Phase, ResetReason};
+use super::{initializer, Engine, Measurement, Output, ResetReason};
 use crate::config::Config;
 use crate::earth::{self, Llh};
 use crate::gnss::spp::{self, SppConfig};
@@ -39,7 +39,7 @@ impl Engine {
         let disagreement = gnss.map(|(position, covariance_enu_m2)| {
             Disagreement::of(prior, &position, &covariance_enu_m2, &self.config)
         });
-        if !self.monitor.check(disagreement.as_ref()) {
+        if !self.monitor.check(report.t_s, disagreement.as_ref()) {
             return None;
         }
         let t_s = report.t_s;
@@ -50,12 +50,9 @@ impl Engine {
         );
         self.divergence_resets += 1;
         self.diverged_at_t_s = Some(t_s);
-        let reset = self.reset(t_s, ResetReason::DivergedFromGnss);
-        // Choice: nothing of the diverged filter is kept (an IMU gap keeps the attitude):
-        // its attitude and biases are what may have gone wrong; the start-up aligns again
-        // from GNSS, in motion if need be.
-        self.phase = Phase::Initializing(Box::<Initializer>::default());
-        Some(reset)
+        // Choice: as after an IMU gap, the attitude and gyro bias are kept and the position
+        // and velocity start again from GNSS.
+        Some(self.reset(t_s, ResetReason::DivergedFromGnss))
     }
 }
 
