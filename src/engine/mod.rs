@@ -28,7 +28,8 @@
 //!   lone spike is dropped and counted, and the strapdown step spans it.
 //! - Each GNSS input seen for the first time feeds the divergence monitor ([`divergence`],
 //!   [`recovery`]) with the prior's disagreement with an independent GNSS position; a
-//!   sustained one resets the filter, which starts again from GNSS, and is counted.
+//!   sustained one is counted and resets the filter as an IMU gap does (the attitude is
+//!   kept, position and velocity start again from GNSS).
 
 mod adaptation;
 pub mod adaptive_noise;
