@@ -1,19 +1,21 @@
 //! The filter's two hot steps: one IMU step (strapdown mechanization plus covariance
-//! propagation) and one tightly-coupled update with 12 satellites (24 measurements).
+//! propagation) and one tightly-coupled update with 12 satellites (24 measurements); and
+//! the divergence monitor's step of a loosely-coupled epoch.
 //! Run with `cargo bench --bench filter_steps`; the README reports the numbers.
 
 use adaptive_gnss_ins::config::{Config, FilterVariant};
 use adaptive_gnss_ins::earth::{self, Llh};
+use adaptive_gnss_ins::engine::divergence::{Disagreement, DivergenceMonitor};
 use adaptive_gnss_ins::engine::update::{self, Pseudoranges};
 use adaptive_gnss_ins::engine::{process_noise, Adaptation, FilterState};
 use adaptive_gnss_ins::gnss::GnssEpoch;
-use adaptive_gnss_ins::ins::error_state::StateMatrix;
+use adaptive_gnss_ins::ins::error_state::{StateMatrix, DP};
 use adaptive_gnss_ins::ins::{ImuSample, NavState};
 use adaptive_gnss_ins::sim::constellation::{
     AtmosphereTruth, GpsConstellation, ObservationNoise, ReceiverTruth,
 };
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use nalgebra::{UnitQuaternion, Vector3};
+use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 
 fn running_state(p: Llh) -> FilterState {
     let q_nb = UnitQuaternion::from_euler_angles(0.01, -0.02, 0.8);
@@ -194,5 +196,35 @@ fn tc_update_adaptive(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, imu_step, tc_update, tc_update_adaptive);
+/// The divergence monitor's step of one receiver fix: the prior's disagreement with it in
+/// units of the combined σ, and the run of disagreeing epochs (here a divergence 3 m off
+/// in a 1 σ covariance, the run growing on every call: the longest path).
+fn divergence_monitor_step(c: &mut Criterion) {
+    let p = Llh::from_degrees(39.1, 117.2, 20.0);
+    let mut state = running_state(p);
+    // A position σ of 0.5 m (latitude and longitude in radians).
+    let rad2 = (0.5 / earth::SEMI_MAJOR_AXIS_M).powi(2);
+    for (i, var) in [rad2, rad2, 0.25].into_iter().enumerate() {
+        state.p[(DP + i, DP + i)] = var;
+    }
+    let config = Config::default();
+    let fix = earth::enu_to_llh(&Vector3::new(3.0, -2.0, 1.0), &p).unwrap();
+    let fix_covariance_enu_m2 = Matrix3::identity() * 0.36;
+    let mut monitor = DivergenceMonitor::default();
+    c.bench_function("divergence_monitor_step_loose", |b| {
+        b.iter(|| {
+            state.nav.t_s += 1.0;
+            let d = Disagreement::of(black_box(&state), &fix, &fix_covariance_enu_m2, &config);
+            black_box(monitor.check(state.nav.t_s, Some(&d)))
+        })
+    });
+}
+
+criterion_group!(
+    benches,
+    imu_step,
+    tc_update,
+    tc_update_adaptive,
+    divergence_monitor_step
+);
 criterion_main!(benches);

@@ -44,6 +44,11 @@ fn run_with(variant: FilterVariant, correlation_aware: bool) -> SessionReport {
     for input in scenario_inputs(&scenario) {
         session.push(input.unwrap());
     }
+    assert_eq!(
+        session.engine().divergence_resets(),
+        0,
+        "{variant:?}: a divergence reset on the default scenario"
+    );
     session.finish()
 }
 

@@ -148,6 +148,12 @@ fn run(config: Config, laps: usize, feed: Feed) -> Run {
         }
     }
     assert!(t_init.is_some_and(|t0| t0 < 30.0), "start-up at {t_init:?}");
+    assert_eq!(
+        engine.divergence_resets(),
+        0,
+        "{}: a divergence reset on a drive that did not diverge",
+        engine.variant_name()
+    );
     let rejected: Vec<_> = engine.counters().iter().collect();
     assert!(
         rejected.is_empty(),

@@ -577,7 +577,7 @@ impl Initializer {
 }
 
 /// Only the satellites of the enabled constellations.
-fn filter_constellations(epoch: &GnssEpoch, config: &Config) -> GnssEpoch {
+pub(super) fn filter_constellations(epoch: &GnssEpoch, config: &Config) -> GnssEpoch {
     GnssEpoch {
         satellites: epoch
             .satellites

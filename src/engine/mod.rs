@@ -26,10 +26,15 @@
 //!   ([`heading_bank`]), and nothing is published until it has decided.
 //! - IMU samples are screened first ([`imu_screen`]): one beyond the sensor's range or a
 //!   lone spike is dropped and counted, and the strapdown step spans it.
+//! - Each GNSS input seen for the first time feeds the divergence monitor ([`divergence`],
+//!   [`recovery`]) with the prior's disagreement with an independent GNSS position; a
+//!   sustained one is counted and resets the filter as an IMU gap does (the attitude is
+//!   kept, position and velocity start again from GNSS).
 
 mod adaptation;
 pub mod adaptive_noise;
 mod constraints;
+pub mod divergence;
 mod filter_state;
 mod fix_track;
 pub mod heading_bank;
@@ -37,6 +42,7 @@ pub mod imu_screen;
 mod initializer;
 mod output;
 pub mod q_scaling;
+mod recovery;
 mod rejection;
 mod retune;
 pub mod standstill;
@@ -51,6 +57,7 @@ use crate::gnss::GnssEpoch;
 use crate::ins::ImuSample;
 
 use constraints::Constraints;
+use divergence::DivergenceMonitor;
 use heading_bank::HeadingBank;
 use imu_screen::{ImuScreen, Screened};
 use standstill::StandstillDetector;
@@ -160,6 +167,12 @@ pub struct Engine {
     standstill: StandstillDetector,
     /// The constraints of the vehicle's motion (`constraints.*`).
     constraints: Constraints,
+    /// The filter against independent GNSS positions.
+    monitor: DivergenceMonitor,
+    /// Resets after a divergence so far.
+    divergence_resets: u64,
+    /// Time of the last divergence while the filter has not started again since.
+    diverged_at_t_s: Option<f64>,
 }
 
 impl Engine {
@@ -179,6 +192,9 @@ impl Engine {
             replaying: false,
             screen: ImuScreen::default(),
             constraints: Constraints::default(),
+            monitor: DivergenceMonitor::default(),
+            divergence_resets: 0,
+            diverged_at_t_s: None,
         }
     }
 
@@ -194,6 +210,17 @@ impl Engine {
     /// The constraint updates applied so far (ZUPT, ZARU, NHC).
     pub fn constraint_updates(&self) -> ConstraintUpdates {
         self.constraints.updates()
+    }
+
+    /// Resets after a divergence from GNSS so far.
+    pub fn divergence_resets(&self) -> u64 {
+        self.divergence_resets
+    }
+
+    /// Time of the divergence the engine is recovering from: set by a divergence reset,
+    /// None again once the filter runs.
+    pub fn diverged_at_t_s(&self) -> Option<f64> {
+        self.diverged_at_t_s
     }
 
     /// The running filter state, or None while initializing.
@@ -251,6 +278,7 @@ impl Engine {
         };
         self.phase = Phase::Initializing(init);
         self.adaptation.reset();
+        self.monitor.clear();
         self.imu.clear();
         self.history.clear();
         self.pending.clear();
@@ -557,7 +585,9 @@ impl Engine {
                 match result {
                     Ok(epoch) if state.is_finite() => {
                         if report {
+                            let reset = self.monitor_divergence(&before, &p.measurement, &epoch);
                             out.push(Output::Epoch(epoch));
+                            out.extend(reset);
                         }
                     }
                     Ok(_) | Err(_) => {

@@ -3,7 +3,7 @@
 
 use nalgebra::{Matrix3, SMatrix, Vector3};
 
-use crate::earth;
+use crate::earth::{self, Llh};
 use crate::gnss::SatId;
 use crate::ins::error_state::{StateMatrix, DP, DV, PHI};
 use crate::ins::NavState;
@@ -30,11 +30,7 @@ pub struct Solution {
 impl Solution {
     /// Covariance of (E, N, U) position in metres², from the (δL, δλ, δh) block.
     pub fn position_covariance_enu_m2(&self) -> Matrix3<f64> {
-        let (north, east) = earth::metres_per_radian(&self.nav.p);
-        // (E, N, U) = T (δL, δλ, δh) with T = [[0, east, 0], [north, 0, 0], [0, 0, 1]].
-        let t = Matrix3::new(0.0, east, 0.0, north, 0.0, 0.0, 0.0, 0.0, 1.0);
-        let block: Matrix3<f64> = self.covariance.fixed_view::<3, 3>(DP, DP).into();
-        t * block * t.transpose()
+        position_covariance_enu_m2(&self.nav.p, &self.covariance)
     }
 
     /// Covariance of the ENU velocity ((m/s)²).
@@ -59,6 +55,16 @@ impl Solution {
         }
         t * self.covariance * t.transpose()
     }
+}
+
+/// Covariance of (E, N, U) position in metres² at `p`, from the (δL, δλ, δh) block of
+/// the error-state covariance `covariance`.
+pub fn position_covariance_enu_m2(p: &Llh, covariance: &StateMatrix) -> Matrix3<f64> {
+    let (north, east) = earth::metres_per_radian(p);
+    // (E, N, U) = T (δL, δλ, δh) with T = [[0, east, 0], [north, 0, 0], [0, 0, 1]].
+    let t = Matrix3::new(0.0, east, 0.0, north, 0.0, 0.0, 0.0, 0.0, 1.0);
+    let block: Matrix3<f64> = covariance.fixed_view::<3, 3>(DP, DP).into();
+    t * block * t.transpose()
 }
 
 /// Why a satellite's measurement was not used.
@@ -234,6 +240,9 @@ pub enum ResetReason {
     Diverged,
     /// The IMU stream moved to another `frame_id` (another sensor), handled by the caller.
     ImuFrameChanged,
+    /// The filter disagreed with independent GNSS positions beyond their combined σ for
+    /// a sustained time (see [`super::divergence`]).
+    DivergedFromGnss,
 }
 
 /// Everything the engine emits.

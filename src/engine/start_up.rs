@@ -80,6 +80,7 @@ impl Engine {
     ) {
         let t_s = state.nav.t_s;
         self.phase = Phase::Running(Box::new(state));
+        self.diverged_at_t_s = None;
         if report {
             out.push(Output::Status(StatusEvent::Initialized {
                 t_s,

@@ -6,9 +6,10 @@ use super::{RosAdapter, TfMode};
 
 impl RosAdapter {
     /// The /diagnostics report at `stamp`: input counts, constraint updates by kind,
-    /// rejections by reason, phase and, in `tf_mode` `map_to_odom` the `odom → base`
-    /// transforms heard and the Odometry messages without a `map → odom`, once running,
-    /// the filter's 3D position sigma (level ERROR when it is not finite); level WARN
+    /// rejections by reason, resets after a divergence, phase and, in `tf_mode`
+    /// `map_to_odom` the `odom → base` transforms heard and the Odometry messages without
+    /// a `map → odom`, once running, the filter's 3D position sigma (level ERROR when it
+    /// is not finite); level ERROR from a divergence until the filter runs again, WARN
     /// while initializing or while a second frame sends on `imu`.
     pub fn diagnostics(&self, node_name: &str, stamp: Time) -> DiagnosticArray {
         let phase = match self.engine.init_phase() {
@@ -45,12 +46,22 @@ impl RosAdapter {
             key: format!("rejected_{}", reason.name()),
             value: n.to_string(),
         }));
-        let (level, message) = match self.engine.state() {
-            None => (
+        values.push(key_value(
+            "divergence_resets",
+            self.engine.divergence_resets().to_string(),
+        ));
+        let (level, message) = match (self.engine.state(), self.engine.diverged_at_t_s()) {
+            (None, Some(t_s)) => (
+                DiagnosticStatus::ERROR,
+                format!(
+                    "the filter diverged from GNSS at t = {t_s:.3} s; no solution while it re-initializes ({phase})"
+                ),
+            ),
+            (None, None) => (
                 DiagnosticStatus::WARN,
                 self.imu_frame_conflict().unwrap_or(phase),
             ),
-            Some(state) => {
+            (Some(state), _) => {
                 let trace_m2 = state.solution().position_covariance_enu_m2().trace();
                 let sigma_m = position_sigma_3d_m(trace_m2);
                 values.push(key_value("position_sigma_3d_m", format!("{sigma_m:.3}")));

@@ -742,3 +742,53 @@ fn constraint_updates_are_counted_on_diagnostics() {
     assert_eq!(non_holonomic, 0);
     assert_eq!(counts("false"), [0, 0, 0]);
 }
+
+/// A divergence on /diagnostics: after a 3 s outage the receiver's fixes come back 500 m
+/// away and stay there (the monitor cannot tell which side moved; it trusts the GNSS that
+/// agrees with itself). The engine resets; until the filter runs again the level is ERROR
+/// and each fix gives a NO_FIX; `divergence_resets` counts the reset, and once the filter
+/// has started again from the fixes the level is OK.
+#[test]
+fn a_divergence_is_an_error_on_diagnostics_until_the_filter_runs_again() {
+    use crate::sim::SimEvent;
+    let mut adapter = loose_adapter(OutputFrames::default());
+    let (mut errors, mut no_fixes_while_diverged) = (0, 0);
+    for_each_static_event(60.0, |event, stamp| {
+        let out = match event {
+            SimEvent::Imu(s) => adapter.on_imu(&outbound::imu(&s, stamp, "imu")),
+            SimEvent::Fix(_) if (30.5..33.0).contains(&event.t_s()) => Vec::new(),
+            SimEvent::Fix(mut f) => {
+                if f.t_s > 30.5 {
+                    let east = nalgebra::Vector3::new(500.0, 0.0, 0.0);
+                    f.position = crate::earth::enu_to_llh(&east, &f.position).unwrap();
+                }
+                adapter.on_fix(&outbound::receiver_fix(&f, stamp, "gnss"))
+            }
+            _ => Vec::new(),
+        };
+        if adapter.engine().diverged_at_t_s().is_some() {
+            assert_eq!(level(&adapter).0, DiagnosticStatus::ERROR);
+            errors += 1;
+            no_fixes_while_diverged += out
+                .iter()
+                .filter(|m| matches!(m, Published::NoFix(_)))
+                .count();
+        }
+    });
+    assert_eq!(adapter.engine().divergence_resets(), 1);
+    assert_eq!(
+        diagnostic(&adapter, "divergence_resets").as_deref(),
+        Some("1")
+    );
+    assert!(
+        errors > 0 && no_fixes_while_diverged > 0,
+        "{errors} {no_fixes_while_diverged}"
+    );
+    assert_eq!(adapter.engine().init_phase(), None, "running again");
+    assert_eq!(
+        level(&adapter).0,
+        DiagnosticStatus::OK,
+        "{:?}",
+        level(&adapter)
+    );
+}

@@ -1,0 +1,101 @@
+//! The engine's side of the divergence monitor ([`super::divergence`]): each GNSS input's
+//! independent position against the filter's prior, and the reset that follows a
+//! divergence.
+
+use nalgebra::Matrix3;
+
+use super::divergence::Disagreement;
+use super::filter_state::FilterState;
+use super::output::{EpochReport, SatRejection};
+use super::update::{position_covariance, sigma_model};
+use super::{initializer, Engine, Measurement, Output, ResetReason};
+use crate::config::Config;
+use crate::earth::{self, Llh};
+use crate::gnss::spp::{self, SppConfig};
+use crate::gnss::GnssEpoch;
+
+/// Share of an epoch's judged pseudo-ranges the gate must have refused before the
+/// single-point solution is computed to judge the filter (tight coupling).
+///
+/// Choice: one half. A filter off by far more than its σ has nearly every pseudo-range
+/// gated out (the classic divergence signature: good data rejected against a wrong state);
+/// on the other epochs the monitor costs a few comparisons and no least squares.
+pub const SPP_ABOVE_GATED_SHARE: f64 = 0.5;
+
+impl Engine {
+    /// Feeds the monitor with the disagreement of `prior` (the filter before the update
+    /// by `m`, whose report is `report`); on divergence resets the filter and returns
+    /// the reset.
+    pub(super) fn monitor_divergence(
+        &mut self,
+        prior: &FilterState,
+        m: &Measurement,
+        report: &EpochReport,
+    ) -> Option<Output> {
+        let gnss = match m {
+            Measurement::Fix(f) => Some((f.position, position_covariance(f, &self.config))),
+            Measurement::Gnss(e) => single_point_if_gated(e, report, prior, &self.config),
+        };
+        let disagreement = gnss.map(|(position, covariance_enu_m2)| {
+            Disagreement::of(prior, &position, &covariance_enu_m2, &self.config)
+        });
+        if !self.monitor.check(report.t_s, disagreement.as_ref()) {
+            return None;
+        }
+        let t_s = report.t_s;
+        log::error!(
+            "the filter diverged from GNSS at t = {t_s:.3} s (beyond {} σ for {} s): re-initializing",
+            super::divergence::DISAGREE_SIGMA,
+            super::divergence::MIN_SPAN_S
+        );
+        self.divergence_resets += 1;
+        self.diverged_at_t_s = Some(t_s);
+        // Choice: as after an IMU gap, the attitude and gyro bias are kept and the position
+        // and velocity start again from GNSS.
+        Some(self.reset(t_s, ResetReason::DivergedFromGnss))
+    }
+}
+
+/// The single-point solution of `epoch` (position and its ENU covariance) when the gate
+/// refused at least [`SPP_ABOVE_GATED_SHARE`] of its judged pseudo-ranges; None otherwise
+/// or when it has no solution with `init.min_satellites`.
+fn single_point_if_gated(
+    epoch: &GnssEpoch,
+    report: &EpochReport,
+    prior: &FilterState,
+    config: &Config,
+) -> Option<(Llh, Matrix3<f64>)> {
+    let gated = |r: &Option<SatRejection>| {
+        matches!(
+            r,
+            Some(SatRejection::InnovationGate | SatRejection::Mahalanobis)
+        )
+    };
+    let judged = report
+        .satellites
+        .iter()
+        .filter(|s| s.used_pseudorange || gated(&s.rejection))
+        .count();
+    let refused = report
+        .satellites
+        .iter()
+        .filter(|s| gated(&s.rejection))
+        .count();
+    if judged == 0 || (refused as f64) < SPP_ABOVE_GATED_SHARE * judged as f64 {
+        return None;
+    }
+    let spp_config = SppConfig {
+        elevation_mask_rad: config.gnss.elevation_mask_rad,
+        sigma: sigma_model(config),
+        initial_position_ecef_m: Some(earth::llh_to_ecef(&prior.nav.p)),
+        ..SppConfig::default()
+    };
+    let epoch = initializer::filter_constellations(epoch, config);
+    let sol = spp::solve_spp(&epoch, &spp_config).ok()?;
+    if sol.num_used < config.init.min_satellites {
+        return None;
+    }
+    let rot = earth::rot_ecef_to_enu(&sol.pos_llh);
+    let cov_ecef: Matrix3<f64> = sol.covariance.fixed_view::<3, 3>(0, 0).into();
+    Some((sol.pos_llh, rot * cov_ecef * rot.transpose()))
+}
