@@ -35,6 +35,7 @@ pub mod heading_bank;
 pub mod imu_screen;
 mod initializer;
 mod output;
+mod phase_anchor;
 pub mod q_scaling;
 mod rejection;
 mod retune;
@@ -513,8 +514,16 @@ impl Engine {
                 let adaptation = &mut self.adaptation;
                 let result = match &p.measurement {
                     Measurement::Gnss(e) => {
-                        let mut model = update::Pseudoranges::new(e, &w, &self.config);
-                        update::apply(state, &mut model, adaptation, report)
+                        let noise = self.process_noise.scaled(adaptation.q.scale());
+                        update::apply_gnss_epoch(
+                            state,
+                            e,
+                            &w,
+                            &self.config,
+                            &noise,
+                            adaptation,
+                            report,
+                        )
                     }
                     Measurement::Fix(f) => {
                         let mut model = update::FixMeasurement::new(f, &w, &self.config, state);

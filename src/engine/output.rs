@@ -71,6 +71,17 @@ pub enum SatRejection {
     NoSatelliteState,
     Mahalanobis,
     ConstellationDisabled,
+    /// The carrier phase may have slipped since the previous epoch (loss of lock, lock
+    /// time decreased, or a phase change the Doppler does not explain).
+    CycleSlip,
+    /// The receiver has not resolved the carrier phase's half-cycle ambiguity.
+    HalfCycleUnresolved,
+    /// The carrier phase has no (valid) wavelength, or another one than at the previous
+    /// epoch.
+    NoWavelength,
+    /// Too few carrier-phase changes passed the other tests for an update that can tell a
+    /// slip from the receiver clock's change.
+    TooFewCarrierPhases,
 }
 
 impl SatRejection {
@@ -84,6 +95,10 @@ impl SatRejection {
             Self::NoSatelliteState => "no_satellite_state",
             Self::Mahalanobis => "mahalanobis",
             Self::ConstellationDisabled => "constellation_disabled",
+            Self::CycleSlip => "cycle_slip",
+            Self::HalfCycleUnresolved => "half_cycle_unresolved",
+            Self::NoWavelength => "no_wavelength",
+            Self::TooFewCarrierPhases => "too_few_carrier_phases",
         }
     }
 }
@@ -149,6 +164,10 @@ pub enum MeasurementKind {
     Pseudoranges,
     /// A position (and optional velocity) fix (loosely coupled).
     Fix,
+    /// Time-differenced carrier phases: each satellite's phase change since the previous
+    /// epoch (tightly coupled; its satellites' pseudo-range fields report the phase change,
+    /// in m, and its rate fields are unused).
+    CarrierPhaseDeltas,
 }
 
 /// The diagnostics of one measurement update.
@@ -184,6 +203,9 @@ pub struct EpochReport {
     /// velocity rows); empty without a robust scheme and in tight coupling, where the
     /// weights are per satellite.
     pub fix_robust_weights: Vec<f64>,
+    /// The report of the epoch's time-differenced carrier-phase update, applied before the
+    /// pseudo-ranges (`gnss.tdcp`; None when off or without a previous epoch's phases).
+    pub carrier_phase_deltas: Option<Box<EpochReport>>,
 }
 
 impl EpochReport {
@@ -204,6 +226,7 @@ impl EpochReport {
             chi2_threshold: f64::NAN,
             q_scale: 1.0,
             fix_robust_weights: Vec::new(),
+            carrier_phase_deltas: None,
         }
     }
 }

@@ -30,6 +30,7 @@
 //! `update::apply(state, &mut model, adaptation, learn)`. `tests.rs` holds a zero-velocity
 //! model written this way.
 
+mod carrier_phase_deltas;
 mod fix;
 mod gate;
 mod model;
@@ -37,19 +38,26 @@ mod pseudoranges;
 #[cfg(test)]
 mod tests;
 
-use nalgebra::{DMatrix, DVector};
+use std::sync::Arc;
 
+use nalgebra::{DMatrix, DVector, Vector3};
+
+use crate::config::Config;
 use crate::filter::ekf::FilterError;
 use crate::filter::measurement_rows::row_variance;
+use crate::filter::process_model::ProcessNoise;
 use crate::filter::robust_update::{ErrorStateModel, MeasurementSet};
+use crate::gnss::GnssEpoch;
 use crate::ins::error_state::{StateVector, N};
 
 use super::adaptation::Adaptation;
 use super::adaptive_noise::ScalarMeasurement;
 use super::filter_state::FilterState;
 use super::output::EpochReport;
+use super::phase_anchor::PhaseAnchor;
 use gate::{gate, GateRow};
 
+pub use carrier_phase_deltas::CarrierPhaseDeltas;
 pub(crate) use fix::{position_covariance, velocity_covariance};
 pub use fix::{FixMeasurement, GnssFix};
 pub use model::{Linearization, MeasurementModel, NoiseChannel, NominalNoise};
@@ -81,6 +89,42 @@ pub fn apply<M: MeasurementModel>(
         NominalNoise::Joint(r) => step.joint(state, &lin, r)?,
     }
     Ok(step.report)
+}
+
+/// Updates `state` with the GNSS epoch `epoch` (tightly coupled): with `gnss.tdcp`, first
+/// the carrier phases' changes since the previous epoch ([`CarrierPhaseDeltas`]), then the
+/// pseudo-ranges and rates ([`Pseudoranges`]), and the epoch's phases become the anchor of
+/// the next. `w_ib_b_rad_s` is the compensated body rate at the epoch, `process_noise`
+/// the process model in use. Returns the pseudo-ranges' report, the phases' report in it.
+///
+/// Choice: the phase changes go first, so their prediction of the displacement since the
+/// previous epoch is the propagated one, before the pseudo-ranges move the position; a
+/// failure of either update fails the epoch (the caller restores the state). One report
+/// per epoch, as without phases, so the outputs downstream keep one per epoch.
+pub fn apply_gnss_epoch(
+    state: &mut FilterState,
+    epoch: &GnssEpoch,
+    w_ib_b_rad_s: &Vector3<f64>,
+    config: &Config,
+    process_noise: &ProcessNoise,
+    adaptation: &mut Adaptation,
+    learn: bool,
+) -> Result<EpochReport, FilterError> {
+    let mut phase_report = None;
+    if config.gnss.tdcp {
+        if let Some(anchor) = state.phase_anchor.clone() {
+            let mut model =
+                CarrierPhaseDeltas::new(epoch, &anchor, w_ib_b_rad_s, config, process_noise);
+            phase_report = Some(Box::new(apply(state, &mut model, adaptation, learn)?));
+        }
+    }
+    let mut model = Pseudoranges::new(epoch, w_ib_b_rad_s, config);
+    let mut report = apply(state, &mut model, adaptation, learn)?;
+    report.carrier_phase_deltas = phase_report;
+    if config.gnss.tdcp {
+        state.phase_anchor = PhaseAnchor::record(epoch, state, w_ib_b_rad_s, config).map(Arc::new);
+    }
+    Ok(report)
 }
 
 /// One measurement on its way through the step.

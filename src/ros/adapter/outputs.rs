@@ -127,6 +127,9 @@ impl Framing {
                     .map(|s| s.sat.constellation),
             ),
             MeasurementKind::Fix => self.fix_service,
+            // Choice: the phases' report rides inside its epoch's pseudo-range report,
+            // which names the service; on its own it changes nothing.
+            MeasurementKind::CarrierPhaseDeltas => return,
         };
         if service != NavSatStatus::SERVICE_UNKNOWN {
             self.service = service;
