@@ -9,7 +9,7 @@
 //! solution is then the one without phases, bit for bit.
 
 use adaptive_gnss_ins::config::Config;
-use adaptive_gnss_ins::engine::{EpochReport, Output, SatRejection};
+use adaptive_gnss_ins::engine::{EpochReport, Output, PhaseRejection};
 use adaptive_gnss_ins::eval::ErrorSummary;
 use adaptive_gnss_ins::gnss::GnssEpoch;
 use adaptive_gnss_ins::sim::Scenario;
@@ -73,11 +73,11 @@ fn print(name: &str, s: &ErrorSummary) {
     );
 }
 
-fn count(reports: &[EpochReport], reason: SatRejection) -> usize {
+fn count(reports: &[EpochReport], reason: PhaseRejection) -> usize {
     reports
         .iter()
         .flat_map(|r| &r.satellites)
-        .filter(|s| s.rejection == Some(reason))
+        .filter(|s| s.phase_rejection == Some(reason))
         .count()
 }
 
@@ -146,10 +146,10 @@ fn bad_phases_are_refused_and_counted_without_a_jump() {
     let with = run(true, corrupt);
     print("pseudo-range rates", &without.summary);
     print("TDCP, bad phases", &with.summary);
-    let slips = count(&with.phase_reports, SatRejection::CycleSlip);
-    let half = count(&with.phase_reports, SatRejection::HalfCycleUnresolved);
-    let no_wavelength = count(&with.phase_reports, SatRejection::NoWavelength);
-    let too_few = count(&with.phase_reports, SatRejection::TooFewCarrierPhases);
+    let slips = count(&with.phase_reports, PhaseRejection::CycleSlip);
+    let half = count(&with.phase_reports, PhaseRejection::HalfCycleUnresolved);
+    let no_wavelength = count(&with.phase_reports, PhaseRejection::NoWavelength);
+    let too_few = count(&with.phase_reports, PhaseRejection::TooFewPhases);
     let used: usize = with.phase_reports.iter().map(|r| r.measurements_used).sum();
     println!(
         "{} TDCP reports: {slips} slips, {half} half cycles, {no_wavelength} without \

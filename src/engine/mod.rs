@@ -58,8 +58,8 @@ pub use adaptation::Adaptation;
 pub use filter_state::{interpolate, FilterState};
 pub use initializer::{InitPhase, Initializer};
 pub use output::{
-    EpochReport, MeasurementKind, Output, ResetReason, SatRejection, SatReport, Solution,
-    StatusEvent,
+    EpochReport, MeasurementKind, Output, PhaseRejection, ResetReason, SatRejection, SatReport,
+    Solution, StatusEvent,
 };
 pub use rejection::{InputRejected, RejectionCounters, RejectionReason};
 pub use retune::{NotRuntimeTunable, RUNTIME_PARAMETERS};

@@ -71,17 +71,6 @@ pub enum SatRejection {
     NoSatelliteState,
     Mahalanobis,
     ConstellationDisabled,
-    /// The carrier phase may have slipped since the previous epoch (loss of lock, lock
-    /// time decreased, or a phase change the Doppler does not explain).
-    CycleSlip,
-    /// The receiver has not resolved the carrier phase's half-cycle ambiguity.
-    HalfCycleUnresolved,
-    /// The carrier phase has no (valid) wavelength, or another one than at the previous
-    /// epoch.
-    NoWavelength,
-    /// Too few carrier-phase changes passed the other tests for an update that can tell a
-    /// slip from the receiver clock's change.
-    TooFewCarrierPhases,
 }
 
 impl SatRejection {
@@ -95,10 +84,34 @@ impl SatRejection {
             Self::NoSatelliteState => "no_satellite_state",
             Self::Mahalanobis => "mahalanobis",
             Self::ConstellationDisabled => "constellation_disabled",
+        }
+    }
+}
+
+/// Why a satellite's carrier-phase change was left out of a time-differenced carrier-phase
+/// update (the reasons it shares with the pseudo-ranges are [`SatRejection`]s).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum PhaseRejection {
+    /// The phase may have slipped since the previous epoch (loss of lock, lock time
+    /// decreased, or a phase change the Doppler does not explain).
+    CycleSlip,
+    /// The receiver has not resolved the half-cycle ambiguity at either epoch.
+    HalfCycleUnresolved,
+    /// No valid wavelength, or another one than at the previous epoch.
+    NoWavelength,
+    /// Too few phase changes passed the other tests for an update that can tell a slip
+    /// from the receiver clock's change.
+    TooFewPhases,
+}
+
+impl PhaseRejection {
+    /// Stable snake_case name, used for counters and diagnostics.
+    pub fn name(self) -> &'static str {
+        match self {
             Self::CycleSlip => "cycle_slip",
             Self::HalfCycleUnresolved => "half_cycle_unresolved",
             Self::NoWavelength => "no_wavelength",
-            Self::TooFewCarrierPhases => "too_few_carrier_phases",
+            Self::TooFewPhases => "too_few_phases",
         }
     }
 }
@@ -114,6 +127,8 @@ pub struct SatReport {
     pub used_rate: bool,
     /// Why the pseudo-range (or, if only that failed, the rate) was left out.
     pub rejection: Option<SatRejection>,
+    /// Why the carrier-phase change was left out (carrier-phase reports only).
+    pub phase_rejection: Option<PhaseRejection>,
     /// Innovation measured − predicted of the pseudo-range (m).
     pub innovation_pseudorange_m: f64,
     /// Innovation measured − predicted of the rate (m/s).
@@ -143,6 +158,7 @@ impl SatReport {
             used_pseudorange: false,
             used_rate: false,
             rejection: None,
+            phase_rejection: None,
             innovation_pseudorange_m: f64::NAN,
             innovation_rate_mps: f64::NAN,
             normalized_innovation_pseudorange: f64::NAN,

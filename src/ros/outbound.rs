@@ -188,10 +188,6 @@ fn rejection_code(reason: Option<SatRejection>) -> u8 {
         Some(SatRejection::ConstellationDisabled) => {
             SatelliteNoise::REJECTION_CONSTELLATION_DISABLED
         }
-        Some(SatRejection::CycleSlip) => SatelliteNoise::REJECTION_CYCLE_SLIP,
-        Some(SatRejection::HalfCycleUnresolved) => SatelliteNoise::REJECTION_HALF_CYCLE_UNRESOLVED,
-        Some(SatRejection::NoWavelength) => SatelliteNoise::REJECTION_NO_WAVELENGTH,
-        Some(SatRejection::TooFewCarrierPhases) => SatelliteNoise::REJECTION_TOO_FEW_CARRIER_PHASES,
     }
 }
 

@@ -47,7 +47,7 @@ use crate::gnss::{CarrierPhase, GnssEpoch, SatObservation};
 use crate::ins::error_state::{DV, N};
 
 use super::super::filter_state::FilterState;
-use super::super::output::{EpochReport, MeasurementKind, SatRejection, SatReport};
+use super::super::output::{EpochReport, MeasurementKind, PhaseRejection, SatRejection, SatReport};
 use super::super::phase_anchor::{AnchoredPhase, PhaseAnchor};
 use super::gate::median;
 use super::model::{Linearization, MeasurementModel, NominalNoise};
@@ -140,13 +140,12 @@ impl MeasurementModel for CarrierPhaseDeltas<'_> {
             };
             let mut sat = SatReport::new(obs.sat);
             let delta = phase_delta_m(obs, &phase, anchored, dt_s, config).and_then(|delta| {
-                Ok((
-                    delta,
-                    screen(obs, &rx_pos, &rx_vel, state, self.epoch, config)?,
-                ))
+                let prediction = screen(obs, &rx_pos, &rx_vel, state, self.epoch, config)
+                    .map_err(Refusal::Sat)?;
+                Ok((delta, prediction))
             });
             match delta {
-                Err(reason) => sat.rejection = Some(reason),
+                Err(refusal) => refusal.report(&mut sat),
                 Ok((delta_m, pred)) => {
                     sat.elevation_rad = pred.elevation_rad;
                     let rate_row = geo.pseudorange_rate_row(&pred.los_ecef);
@@ -257,9 +256,28 @@ impl CarrierPhaseDeltas<'_> {
             return;
         }
         for source in self.sources.drain(..) {
-            report.satellites[source.sat_index].rejection = Some(SatRejection::TooFewCarrierPhases);
+            report.satellites[source.sat_index].phase_rejection =
+                Some(PhaseRejection::TooFewPhases);
         }
         measurements.clear();
+    }
+}
+
+/// Why a satellite's phase change is left out.
+enum Refusal {
+    /// For a reason the pseudo-ranges share.
+    Sat(SatRejection),
+    /// For a reason of the phase's own.
+    Phase(PhaseRejection),
+}
+
+impl Refusal {
+    /// Notes it in the satellite's report.
+    fn report(self, sat: &mut SatReport) {
+        match self {
+            Self::Sat(reason) => sat.rejection = Some(reason),
+            Self::Phase(reason) => sat.phase_rejection = Some(reason),
+        }
     }
 }
 
@@ -296,28 +314,28 @@ fn phase_delta_m(
     anchored: &AnchoredPhase,
     dt_s: f64,
     config: &Config,
-) -> Result<f64, SatRejection> {
+) -> Result<f64, Refusal> {
     if !config.gnss.constellations.contains(&obs.sat.constellation) {
-        return Err(SatRejection::ConstellationDisabled);
+        return Err(Refusal::Sat(SatRejection::ConstellationDisabled));
     }
     let before = &anchored.phase;
     let wavelength_m = match (phase.wavelength_m, before.wavelength_m) {
         (Some(now), Some(then)) if now.is_finite() && now > 0.0 && now == then => now,
-        _ => return Err(SatRejection::NoWavelength),
+        _ => return Err(Refusal::Phase(PhaseRejection::NoWavelength)),
     };
     if phase.half_cycle_unresolved || before.half_cycle_unresolved {
-        return Err(SatRejection::HalfCycleUnresolved);
+        return Err(Refusal::Phase(PhaseRejection::HalfCycleUnresolved));
     }
     let lock_decreased = matches!(
         (phase.lock_time_s, before.lock_time_s),
         (Some(now), Some(then)) if !(now >= then)
     );
     if phase.loss_of_lock || lock_decreased {
-        return Err(SatRejection::CycleSlip);
+        return Err(Refusal::Phase(PhaseRejection::CycleSlip));
     }
     let delta_m = (phase.cycles - before.cycles) * wavelength_m;
     if !delta_m.is_finite() {
-        return Err(SatRejection::NotANumber);
+        return Err(Refusal::Sat(SatRejection::NotANumber));
     }
     // Choice: the trapezoid of both epochs' rates where both are there, else the one there
     // is; without Doppler the test is skipped and the innovation gate remains.
@@ -330,7 +348,7 @@ fn phase_delta_m(
     if !finite.is_empty() {
         let doppler_m = finite.iter().sum::<f64>() / finite.len() as f64 * dt_s;
         if (delta_m - doppler_m).abs() > config.gnss.tdcp_slip_threshold_m {
-            return Err(SatRejection::CycleSlip);
+            return Err(Refusal::Phase(PhaseRejection::CycleSlip));
         }
     }
     Ok(delta_m)

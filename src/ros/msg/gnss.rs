@@ -152,14 +152,6 @@ impl SatelliteNoise {
     pub const REJECTION_MAHALANOBIS: u8 = 6;
     /// Constellation disabled in the configuration.
     pub const REJECTION_CONSTELLATION_DISABLED: u8 = 7;
-    /// Carrier phase: a cycle slip since the previous epoch is possible.
-    pub const REJECTION_CYCLE_SLIP: u8 = 8;
-    /// Carrier phase: the half-cycle ambiguity is not resolved.
-    pub const REJECTION_HALF_CYCLE_UNRESOLVED: u8 = 9;
-    /// Carrier phase: no valid wavelength, or another one than at the previous epoch.
-    pub const REJECTION_NO_WAVELENGTH: u8 = 10;
-    /// Carrier phase: too few satellites' phase changes left for an update.
-    pub const REJECTION_TOO_FEW_CARRIER_PHASES: u8 = 11;
 }
 
 /// `adaptive_gnss_ins/msg/NoiseEstimates`: noise estimates and consistency statistics of
