@@ -60,12 +60,15 @@ use super::pseudoranges::{screen, sigma_model};
 /// absorbs a slip of a few cycles on a lone satellite unseen, and the update adds little.
 const MIN_ROWS: usize = 4;
 
-/// One row: its satellite in the report, its row of H and its prediction from the prior.
+/// One row: its satellite in the report, its row of H, its measured phase change, its
+/// prediction from the prior and its variance.
 #[derive(Debug, Clone, Copy)]
 struct DeltaSource {
     sat_index: usize,
     row: Row,
+    measured_m: f64,
     predicted_m: f64,
+    r_m2: f64,
 }
 
 /// The phase changes of one epoch against `anchor`; `w_ib_b_rad_s` is the compensated
@@ -131,8 +134,6 @@ impl MeasurementModel for CarrierPhaseDeltas<'_> {
         let sigmas = sigma_model(config);
         // Process noise inside the interval (see the module's Choice).
         let within_interval_m2 = config.imu.accel_vrw_m_s_per_sqrt_s.powi(2) * dt_s.powi(3) / 3.0;
-        // Each row's measured phase change and its variance.
-        let mut measurements = Vec::new();
         for obs in &self.epoch.satellites {
             let (Some(phase), Some(anchored)) = (obs.carrier_phase, self.anchor.get(obs.sat))
             else {
@@ -158,23 +159,23 @@ impl MeasurementModel for CarrierPhaseDeltas<'_> {
                     self.sources.push(DeltaSource {
                         sat_index: report.satellites.len(),
                         row,
+                        measured_m: delta_m,
                         predicted_m: pred.pseudorange_m - anchored.predicted_pseudorange_m,
+                        r_m2: r,
                     });
-                    measurements.push((delta_m, r));
                 }
             }
             report.satellites.push(sat);
         }
-        self.gate(state, &mut measurements, report);
-        self.require_redundancy(&mut measurements, report);
-        let measured: Vec<f64> = measurements.iter().map(|(delta, _)| *delta).collect();
+        self.gate(state, report);
+        self.require_redundancy(report);
         let r = DMatrix::from_diagonal(&DVector::from_iterator(
-            measurements.len(),
-            measurements.iter().map(|(_, r)| *r),
+            self.sources.len(),
+            self.sources.iter().map(|s| s.r_m2),
         ));
         Linearization {
             rows: self.sources.iter().map(|s| s.row).collect(),
-            measured,
+            measured: self.sources.iter().map(|s| s.measured_m).collect(),
             predicted: self.sources.iter().map(|s| s.predicted_m).collect(),
             noise: NominalNoise::Joint(r),
         }
@@ -189,7 +190,9 @@ impl MeasurementModel for CarrierPhaseDeltas<'_> {
             rows.len(),
             rows.iter().map(|&i| {
                 let source = &self.sources[i];
-                source.predicted_m + (source.row * dx)[0]
+                // The nominal state is the true one plus the error: the corrected state's
+                // prediction is the prior's minus H·δx.
+                source.predicted_m - (source.row * dx)[0]
             }),
         )
     }
@@ -209,49 +212,38 @@ impl MeasurementModel for CarrierPhaseDeltas<'_> {
 impl CarrierPhaseDeltas<'_> {
     /// The innovation gate `gnss.innovation_gate_sigma` around the median innovation (the
     /// clock drift's error is common to all rows), as the pseudo-ranges' gate; drops the
-    /// rows (and `measurements`) it leaves out and reports them.
-    fn gate(
-        &mut self,
-        state: &FilterState,
-        measurements: &mut Vec<(f64, f64)>,
-        report: &mut EpochReport,
-    ) {
+    /// rows it leaves out and reports them.
+    fn gate(&mut self, state: &FilterState, report: &mut EpochReport) {
         let gate_sigma = self.config.gnss.innovation_gate_sigma;
         if gate_sigma <= 0.0 {
             return;
         }
-        let ys: Vec<f64> = self
+        let mut ys: Vec<f64> = self
             .sources
             .iter()
-            .zip(measurements.iter())
-            .map(|(s, (delta, _))| s.predicted_m - delta)
+            .map(|s| s.predicted_m - s.measured_m)
             .collect();
         let offset = if ys.len() >= 3 {
-            median(&mut ys.clone()).unwrap_or(0.0)
+            median(&mut ys).unwrap_or(0.0)
         } else {
             0.0
         };
-        let mut kept = 0;
-        for i in 0..ys.len() {
-            let source = self.sources[i];
-            let s = row_variance(&source.row, &state.p) + measurements[i].1;
-            if (ys[i] - offset).abs() <= gate_sigma * s.sqrt() {
-                self.sources[kept] = source;
-                measurements[kept] = measurements[i];
-                kept += 1;
-            } else {
+        self.sources.retain(|source| {
+            let y = source.predicted_m - source.measured_m;
+            let s = row_variance(&source.row, &state.p) + source.r_m2;
+            let kept = (y - offset).abs() <= gate_sigma * s.sqrt();
+            if !kept {
                 let sat = &mut report.satellites[source.sat_index];
                 sat.rejection = Some(SatRejection::InnovationGate);
-                sat.innovation_pseudorange_m = -ys[i];
-                sat.normalized_innovation_pseudorange = -ys[i] / s.sqrt();
+                sat.innovation_pseudorange_m = -y;
+                sat.normalized_innovation_pseudorange = -y / s.sqrt();
             }
-        }
-        self.sources.truncate(kept);
-        measurements.truncate(kept);
+            kept
+        });
     }
 
     /// Leaves every row out, reported, when fewer than [`MIN_ROWS`] are left.
-    fn require_redundancy(&mut self, measurements: &mut Vec<(f64, f64)>, report: &mut EpochReport) {
+    fn require_redundancy(&mut self, report: &mut EpochReport) {
         if self.sources.len() >= MIN_ROWS {
             return;
         }
@@ -259,7 +251,6 @@ impl CarrierPhaseDeltas<'_> {
             report.satellites[source.sat_index].phase_rejection =
                 Some(PhaseRejection::TooFewPhases);
         }
-        measurements.clear();
     }
 }
 
@@ -328,7 +319,7 @@ fn phase_delta_m(
     }
     let lock_decreased = matches!(
         (phase.lock_time_s, before.lock_time_s),
-        (Some(now), Some(then)) if !(now >= then)
+        (Some(now), Some(then)) if now.partial_cmp(&then).is_none_or(|o| o.is_lt())
     );
     if phase.loss_of_lock || lock_decreased {
         return Err(Refusal::Phase(PhaseRejection::CycleSlip));

@@ -15,8 +15,10 @@
 //!
 //! Nothing learns from a measurement re-applied after a roll-back (`learn` false).
 //!
-//! Models: [`Pseudoranges`] (tightly coupled: pseudo-ranges and rates of a GNSS epoch) and
-//! [`FixMeasurement`] (loosely coupled: a receiver's position and velocity fix).
+//! Models: [`Pseudoranges`] (tightly coupled: pseudo-ranges and rates of a GNSS epoch),
+//! [`CarrierPhaseDeltas`] (tightly coupled, optional: the carrier phases' changes since the
+//! previous epoch; [`apply_gnss_epoch`] runs both) and [`FixMeasurement`] (loosely coupled:
+//! a receiver's position and velocity fix).
 //!
 //! Adding a model (zero velocity, non-holonomic constraint, wheel speed, time-differenced
 //! carrier phase, ...): a file here with a type that borrows the measurement and the
