@@ -39,6 +39,7 @@ fn running_state(p: Llh) -> FilterState {
         p: StateMatrix::identity() * 1e-2,
         prev_increment: None,
         last_imu: imu,
+        phase_anchor: None,
     }
 }
 

@@ -99,6 +99,10 @@ const EVERY_KEY_CHANGED: &str = "
       innovation_gate_sigma: 0.0
       constellations: [glonass, qzss, sbas, gps]
       clock_jump_threshold_m: 5000.0
+      tdcp: true
+      tdcp_phase_sigma_m: 0.02
+      tdcp_slip_threshold_m: 0.3
+      tdcp_max_interval_s: 2.5
     loose:
       use_fix_covariance: false
       fix_sigma_horizontal_m: 2.5

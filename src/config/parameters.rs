@@ -260,6 +260,23 @@ parameter_table! {
         /// receiver clock jump (receivers jump whole milliseconds, about 300 km).
         max_clock_jump_m: f64 ["clock_jump_threshold_m": f64] = 100_000.0,
             unit "m", range Range::Within(Interval::above(0.0, 1e7)), at_run_time;
+        /// Fuse time-differenced carrier phase (TDCP): each satellite's phase change
+        /// between consecutive epochs, a measurement of the antenna's displacement over the
+        /// interval (and the receiver clock's change), applied before the epoch's
+        /// pseudo-ranges. Needs carrier phase in the measurements; satellites without it,
+        /// or with a cycle slip, are left out and counted.
+        tdcp: bool = false, unit "", range ANY, at_start;
+        /// Zenith 1-sigma of one carrier-phase measurement (the difference of two epochs
+        /// has sqrt(2) times it), scaled by elevation as the pseudo-range sigmas.
+        tdcp_phase_sigma_m: f64 = 0.01,
+            unit "m", range SIGMA, at_run_time;
+        /// A phase change further than this from the change the Doppler (pseudo-range
+        /// rates of both epochs, trapezoid) predicts is a cycle slip.
+        tdcp_slip_threshold_m: f64 = 0.5,
+            unit "m", range THRESHOLD, at_run_time;
+        /// Epochs further apart than this are not differenced.
+        tdcp_max_interval_s: f64 = 1.5,
+            unit "s", range Range::Within(Interval::above(0.0, 60.0)), at_run_time;
     }
 
     /// Weighting of the receiver fix in loose coupling.

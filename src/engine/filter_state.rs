@@ -1,6 +1,8 @@
 //! The running filter: nominal state, sensor and clock error estimates, covariance; the
 //! IMU propagation step and the closed-loop feedback of an error-state estimate.
 
+use std::sync::Arc;
+
 use nalgebra::{UnitQuaternion, Vector3};
 
 use crate::filter::process_model::{self, LinearizationPoint, ProcessNoise};
@@ -11,6 +13,7 @@ use crate::ins::mechanization::{self, ImuIncrement, MechanizationError};
 use crate::ins::{ImuSample, NavState};
 
 use super::output::Solution;
+use super::phase_anchor::PhaseAnchor;
 
 /// Filter state between IMU samples.
 #[derive(Debug, Clone, PartialEq)]
@@ -29,6 +32,8 @@ pub struct FilterState {
     pub prev_increment: Option<ImuIncrement>,
     /// The last body-frame IMU sample the state was propagated to (raw, uncompensated).
     pub last_imu: ImuSample,
+    /// The carrier phases of the last GNSS epoch (time-differenced carrier phase only).
+    pub phase_anchor: Option<Arc<PhaseAnchor>>,
 }
 
 impl FilterState {
@@ -88,6 +93,29 @@ impl FilterState {
         self.accel_bias_m_s2 += dx.fixed_rows::<3>(ACC_BIAS);
         self.clock_bias_m -= dx[CLOCK_BIAS];
         self.clock_drift_mps -= dx[CLOCK_DRIFT];
+    }
+
+    /// The error state δx that [`Self::apply_correction`] would take from `self` to
+    /// `corrected` (its inverse): the difference of two nominal states in the error state's
+    /// coordinates and sign conventions.
+    pub fn error_towards(&self, corrected: &Self) -> StateVector {
+        let mut dx = StateVector::zeros();
+        let phi = (corrected.nav.q_nb * self.nav.q_nb.inverse()).scaled_axis();
+        dx.fixed_rows_mut::<3>(PHI).copy_from(&phi);
+        dx.fixed_rows_mut::<3>(DV)
+            .copy_from(&(self.nav.v_n - corrected.nav.v_n));
+        dx[DP] = self.nav.p.lat_rad - corrected.nav.p.lat_rad;
+        dx[DP + 1] = self.nav.p.lon_rad - corrected.nav.p.lon_rad;
+        dx[DP + 2] = self.nav.p.height_m - corrected.nav.p.height_m;
+        dx.fixed_rows_mut::<3>(GYRO_BIAS)
+            .copy_from(&(corrected.gyro_bias_rad_s - self.gyro_bias_rad_s));
+        dx.fixed_rows_mut::<3>(GYRO_GM)
+            .copy_from(&(corrected.gyro_markov_rad_s - self.gyro_markov_rad_s));
+        dx.fixed_rows_mut::<3>(ACC_BIAS)
+            .copy_from(&(corrected.accel_bias_m_s2 - self.accel_bias_m_s2));
+        dx[CLOCK_BIAS] = self.clock_bias_m - corrected.clock_bias_m;
+        dx[CLOCK_DRIFT] = self.clock_drift_mps - corrected.clock_drift_mps;
+        dx
     }
 
     /// True when every number of the state is finite.

@@ -41,6 +41,7 @@ pub mod heading_bank;
 pub mod imu_screen;
 mod initializer;
 mod output;
+mod phase_anchor;
 pub mod q_scaling;
 mod recovery;
 mod rejection;
@@ -67,8 +68,8 @@ pub use constraints::ConstraintUpdates;
 pub use filter_state::{interpolate, FilterState};
 pub use initializer::{InitPhase, Initializer};
 pub use output::{
-    EpochReport, MeasurementKind, Output, ResetReason, SatRejection, SatReport, Solution,
-    StatusEvent,
+    EpochReport, MeasurementKind, Output, PhaseRejection, ResetReason, SatRejection, SatReport,
+    Solution, StatusEvent,
 };
 pub use rejection::{InputRejected, RejectionCounters, RejectionReason};
 pub use retune::{NotRuntimeTunable, RUNTIME_PARAMETERS};
@@ -574,8 +575,16 @@ impl Engine {
                 let adaptation = &mut self.adaptation;
                 let result = match &p.measurement {
                     Measurement::Gnss(e) => {
-                        let mut model = update::Pseudoranges::new(e, &w, &self.config);
-                        update::apply(state, &mut model, adaptation, report)
+                        let noise = self.process_noise.scaled(adaptation.q.scale());
+                        update::apply_gnss_epoch(
+                            state,
+                            e,
+                            &w,
+                            &self.config,
+                            &noise,
+                            adaptation,
+                            report,
+                        )
                     }
                     Measurement::Fix(f) => {
                         let mut model = update::FixMeasurement::new(f, &w, &self.config, state);

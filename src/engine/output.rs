@@ -94,6 +94,34 @@ impl SatRejection {
     }
 }
 
+/// Why a satellite's carrier-phase change was left out of a time-differenced carrier-phase
+/// update (the reasons it shares with the pseudo-ranges are [`SatRejection`]s).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum PhaseRejection {
+    /// The phase may have slipped since the previous epoch (loss of lock, lock time
+    /// decreased, or a phase change the Doppler does not explain).
+    CycleSlip,
+    /// The receiver has not resolved the half-cycle ambiguity at either epoch.
+    HalfCycleUnresolved,
+    /// No valid wavelength, or another one than at the previous epoch.
+    NoWavelength,
+    /// Too few phase changes passed the other tests for an update that can tell a slip
+    /// from the receiver clock's change.
+    TooFewPhases,
+}
+
+impl PhaseRejection {
+    /// Stable snake_case name, used for counters and diagnostics.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::CycleSlip => "cycle_slip",
+            Self::HalfCycleUnresolved => "half_cycle_unresolved",
+            Self::NoWavelength => "no_wavelength",
+            Self::TooFewPhases => "too_few_phases",
+        }
+    }
+}
+
 /// One satellite's part of an epoch report. NaN marks a value that was not computed.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SatReport {
@@ -105,6 +133,8 @@ pub struct SatReport {
     pub used_rate: bool,
     /// Why the pseudo-range (or, if only that failed, the rate) was left out.
     pub rejection: Option<SatRejection>,
+    /// Why the carrier-phase change was left out (carrier-phase reports only).
+    pub phase_rejection: Option<PhaseRejection>,
     /// Innovation measured − predicted of the pseudo-range (m).
     pub innovation_pseudorange_m: f64,
     /// Innovation measured − predicted of the rate (m/s).
@@ -134,6 +164,7 @@ impl SatReport {
             used_pseudorange: false,
             used_rate: false,
             rejection: None,
+            phase_rejection: None,
             innovation_pseudorange_m: f64::NAN,
             innovation_rate_mps: f64::NAN,
             normalized_innovation_pseudorange: f64::NAN,
@@ -161,6 +192,10 @@ pub enum MeasurementKind {
     ZeroRate,
     /// No lateral or vertical velocity of a wheeled vehicle (NHC).
     NonHolonomic,
+    /// Time-differenced carrier phases: each satellite's phase change since the previous
+    /// epoch (tightly coupled; its satellites' pseudo-range fields report the phase change,
+    /// in m, and its rate fields are unused).
+    CarrierPhaseDeltas,
 }
 
 /// The diagnostics of one measurement update.
@@ -196,6 +231,9 @@ pub struct EpochReport {
     /// velocity rows); empty without a robust scheme and in tight coupling, where the
     /// weights are per satellite.
     pub fix_robust_weights: Vec<f64>,
+    /// The report of the epoch's time-differenced carrier-phase update, applied before the
+    /// pseudo-ranges (`gnss.tdcp`; None when off or without a previous epoch's phases).
+    pub carrier_phase_deltas: Option<Box<EpochReport>>,
 }
 
 impl EpochReport {
@@ -216,6 +254,7 @@ impl EpochReport {
             chi2_threshold: f64::NAN,
             q_scale: 1.0,
             fix_robust_weights: Vec::new(),
+            carrier_phase_deltas: None,
         }
     }
 }

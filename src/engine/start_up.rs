@@ -68,6 +68,7 @@ impl Engine {
             p: initial.p,
             prev_increment: None,
             last_imu: interpolate(&before, next, t),
+            phase_anchor: None,
         }
     }
 

@@ -104,7 +104,8 @@ impl SigmaModel {
         }
     }
 
-    fn scaled(&self, zenith: f64, elevation_rad: Option<f64>) -> f64 {
+    /// The zenith σ `zenith` of any observable at `elevation_rad` (None: zenith σ).
+    pub fn scaled(&self, zenith: f64, elevation_rad: Option<f64>) -> f64 {
         match elevation_rad {
             Some(el) => zenith / el.max(self.min_elevation_rad).sin(),
             None => zenith,

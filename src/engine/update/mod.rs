@@ -16,13 +16,14 @@
 //! Nothing learns from a measurement re-applied after a roll-back (`learn` false).
 //!
 //! Models: [`Pseudoranges`] (tightly coupled: pseudo-ranges and rates of a GNSS epoch),
-//! [`FixMeasurement`] (loosely coupled: a receiver's position and velocity fix), and the
-//! constraints of the vehicle's motion (`super::constraints`): [`ZeroVelocity`],
-//! [`ZeroRate`] at a standstill and [`NonHolonomic`] for a wheeled vehicle.
+//! [`CarrierPhaseDeltas`] (tightly coupled, optional: the carrier phases' changes since the
+//! previous epoch; [`apply_gnss_epoch`] runs both), [`FixMeasurement`] (loosely coupled: a
+//! receiver's position and velocity fix), and the constraints of the vehicle's motion
+//! (`super::constraints`): [`ZeroVelocity`], [`ZeroRate`] at a standstill and
+//! [`NonHolonomic`] for a wheeled vehicle.
 //!
-//! Adding a model (zero velocity, non-holonomic constraint, wheel speed, time-differenced
-//! carrier phase, ...): a file here with a type that borrows the measurement and the
-//! configuration and implements [`MeasurementModel`]; its `linearize` returns the rows of H
+//! Adding a model (wheel speed, a dual-antenna heading, ...): a file here with a type that
+//! borrows the measurement and the configuration and implements [`MeasurementModel`]; its `linearize` returns the rows of H
 //! (new rows belong in [`crate::filter::measurement_rows`]), the measured and predicted
 //! values and the nominal noise — [`NominalNoise::Joint`] for a vector measurement (the
 //! residual strategy learns one window per [`super::MeasurementKind`]),
@@ -32,6 +33,7 @@
 //! `update::apply(state, &mut model, adaptation, learn)`. `tests.rs` runs the
 //! zero-velocity model through every base and scheme.
 
+mod carrier_phase_deltas;
 mod fix;
 mod gate;
 mod model;
@@ -42,19 +44,26 @@ mod tests;
 mod zero_rate;
 mod zero_velocity;
 
-use nalgebra::{DMatrix, DVector};
+use std::sync::Arc;
 
+use nalgebra::{DMatrix, DVector, Vector3};
+
+use crate::config::Config;
 use crate::filter::ekf::FilterError;
 use crate::filter::measurement_rows::row_variance;
+use crate::filter::process_model::ProcessNoise;
 use crate::filter::robust_update::{ErrorStateModel, MeasurementSet};
+use crate::gnss::GnssEpoch;
 use crate::ins::error_state::{StateVector, N};
 
 use super::adaptation::Adaptation;
 use super::adaptive_noise::ScalarMeasurement;
 use super::filter_state::FilterState;
 use super::output::EpochReport;
+use super::phase_anchor::PhaseAnchor;
 use gate::{gate, GateRow};
 
+pub use carrier_phase_deltas::CarrierPhaseDeltas;
 pub(crate) use fix::{position_covariance, velocity_covariance};
 pub use fix::{FixMeasurement, GnssFix};
 pub use model::{Linearization, MeasurementModel, NoiseChannel, NominalNoise};
@@ -89,6 +98,42 @@ pub fn apply<M: MeasurementModel>(
         NominalNoise::Joint(r) => step.joint(state, &lin, r)?,
     }
     Ok(step.report)
+}
+
+/// Updates `state` with the GNSS epoch `epoch` (tightly coupled): with `gnss.tdcp`, first
+/// the carrier phases' changes since the previous epoch ([`CarrierPhaseDeltas`]), then the
+/// pseudo-ranges and rates ([`Pseudoranges`]), and the epoch's phases become the anchor of
+/// the next. `w_ib_b_rad_s` is the compensated body rate at the epoch, `process_noise`
+/// the process model in use. Returns the pseudo-ranges' report, the phases' report in it.
+///
+/// Choice: the phase changes go first, so their prediction of the displacement since the
+/// previous epoch is the propagated one, before the pseudo-ranges move the position; a
+/// failure of either update fails the epoch (the caller restores the state). One report
+/// per epoch, as without phases, so the outputs downstream keep one per epoch.
+pub fn apply_gnss_epoch(
+    state: &mut FilterState,
+    epoch: &GnssEpoch,
+    w_ib_b_rad_s: &Vector3<f64>,
+    config: &Config,
+    process_noise: &ProcessNoise,
+    adaptation: &mut Adaptation,
+    learn: bool,
+) -> Result<EpochReport, FilterError> {
+    let mut phase_report = None;
+    if config.gnss.tdcp {
+        if let Some(anchor) = state.phase_anchor.clone() {
+            let mut model =
+                CarrierPhaseDeltas::new(epoch, &anchor, w_ib_b_rad_s, config, process_noise);
+            phase_report = Some(Box::new(apply(state, &mut model, adaptation, learn)?));
+        }
+    }
+    let mut model = Pseudoranges::new(epoch, w_ib_b_rad_s, config);
+    let mut report = apply(state, &mut model, adaptation, learn)?;
+    report.carrier_phase_deltas = phase_report;
+    if config.gnss.tdcp {
+        state.phase_anchor = PhaseAnchor::record(epoch, state, w_ib_b_rad_s, config).map(Arc::new);
+    }
+    Ok(report)
 }
 
 /// One measurement on its way through the step.

@@ -305,7 +305,7 @@ fn predicted(p: &SatPrediction, observable: Observable) -> f64 {
 }
 
 /// Checks one observation against the masks and predicts it.
-fn screen(
+pub(super) fn screen(
     obs: &SatObservation,
     rx_pos: &Vector3<f64>,
     rx_vel: &Vector3<f64>,

@@ -61,6 +61,7 @@ fn moving_state(p_velocity_m2_s2: f64) -> FilterState {
         p: StateMatrix::identity() * p_velocity_m2_s2,
         prev_increment: None,
         last_imu: imu,
+        phase_anchor: None,
     }
 }
 

@@ -155,6 +155,9 @@ impl Framing {
             MeasurementKind::ZeroVelocity
             | MeasurementKind::ZeroRate
             | MeasurementKind::NonHolonomic => return,
+            // Choice: the phases' report rides inside its epoch's pseudo-range report,
+            // which names the service; on its own it changes nothing.
+            MeasurementKind::CarrierPhaseDeltas => return,
         };
         if service != NavSatStatus::SERVICE_UNKNOWN {
             self.service = service;
