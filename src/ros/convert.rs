@@ -722,7 +722,8 @@ mod tests {
 
     #[test]
     fn a_satellite_state_no_gnss_satellite_has_names_the_field() {
-        let cases: [(fn(&mut SatelliteMeasurement), &str); 5] = [
+        type Corruption = fn(&mut SatelliteMeasurement);
+        let cases: [(Corruption, &str); 5] = [
             (
                 // On the ground.
                 |s| {
