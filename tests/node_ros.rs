@@ -7,21 +7,18 @@
 //! discovery still works between processes of the namespace.
 
 mod netns_support;
+mod static_node_support;
 
-use std::process::{Command, Stdio};
+use std::process::Command;
 use std::time::{Duration, Instant};
 
 use adaptive_gnss_ins::earth::{self, Llh};
 use adaptive_gnss_ins::ros::convert::seconds_to_time;
-use adaptive_gnss_ins::ros::msg::{
-    DiagnosticArray, GnssMeasurements, Imu, Odometry, RosMessage, TFMessage,
-};
+use adaptive_gnss_ins::ros::msg::{DiagnosticArray, GnssMeasurements, Imu};
 use adaptive_gnss_ins::ros::outbound;
-use adaptive_gnss_ins::sim::{Scenario, SimEvent};
-use netns_support::{reexec_in_private_netns, KillOnDrop};
-use ros2_client::{
-    Context, ContextOptions, MessageTypeName, Name, NodeName, NodeOptions, QosProfile,
-};
+use adaptive_gnss_ins::sim::SimEvent;
+use netns_support::reexec_in_private_netns;
+use static_node_support::{start_node, static_scenario, Peer};
 
 const DOMAIN_ID: u16 = 17;
 /// Position budget of the ekf preset on a static receiver after a minute of 1 Hz GNSS,
@@ -31,92 +28,35 @@ const MAX_STATIC_POSITION_ERR_M: f64 = 7.0;
 const STREAM_S: f64 = 60.0;
 const SPEED_UP: f64 = 20.0;
 
-fn type_name<M: RosMessage>() -> MessageTypeName {
-    let parts: Vec<&str> = M::TYPE_NAME.split('/').collect();
-    MessageTypeName::new(parts[0], parts[2])
-}
-
 #[test]
 fn node_estimates_a_static_receiver() {
     if reexec_in_private_netns("node_estimates_a_static_receiver") {
         return;
     }
-    let scenario = Scenario::builtin("static", 3).unwrap();
+    let scenario = static_scenario();
     let spec = &scenario.spec().trajectory;
     let truth = Llh::from_degrees(spec.start_lat_deg, spec.start_lon_deg, spec.start_height_m);
-    let params = concat!(env!("CARGO_MANIFEST_DIR"), "/params/ekf.yaml");
-    let datum = format!(
-        "output.datum_llh_deg_m:=[{}, {}, {}]",
-        spec.start_lat_deg, spec.start_lon_deg, spec.start_height_m
+    let _node = start_node(
+        DOMAIN_ID,
+        &scenario,
+        &[
+            "-r",
+            "imu:=imu/data",
+            "-p",
+            "publish_tf:=true",
+            "-p",
+            "base_frame:=imu_link",
+        ],
     );
-    let node = Command::new(env!("CARGO_BIN_EXE_gnss_ins_node"))
-        .args(["--ros-args", "--params-file", params])
-        .args(["-p", "init.heading_deg:=0.0", "-p", &datum])
-        .args(["-r", "__ns:=/test", "-r", "imu:=imu/data"])
-        .args(["-p", "publish_tf:=true", "-p", "base_frame:=imu_link"])
-        .args(["-p", "queue_depth:=500"])
-        .env("ROS_DOMAIN_ID", DOMAIN_ID.to_string())
-        .env("RUST_LOG", "info,rustdds=error,ros2_client=warn")
-        .stdin(Stdio::null())
-        .spawn()
-        .unwrap();
-    let _node = KillOnDrop(node);
-
-    let context = Context::with_options(ContextOptions::new().domain_id(DOMAIN_ID)).unwrap();
-    let mut peer = context
-        .new_node(
-            NodeName::new("/test", "stream_player").unwrap(),
-            NodeOptions::new()
-                .enable_rosout(false)
-                .start_parameter_services(false),
-        )
-        .unwrap();
-    let reliable = QosProfile::publisher_default()
-        .history(ros2_client::qos::History::KeepLast { depth: 20_000 });
-    let topic = |peer: &mut ros2_client::Node, name: &str, t: MessageTypeName| {
-        peer.create_topic(&Name::parse(name).unwrap(), t, &reliable)
-            .unwrap()
-    };
-    let imu_topic = topic(&mut peer, "/test/imu/data", type_name::<Imu>());
-    let gnss_topic = topic(
-        &mut peer,
-        "/test/gnss/measurements",
-        type_name::<GnssMeasurements>(),
-    );
-    let odom_topic = topic(&mut peer, "/test/odometry", type_name::<Odometry>());
-    let diag_topic = topic(&mut peer, "/diagnostics", type_name::<DiagnosticArray>());
-    let tf_topic = topic(&mut peer, "/tf", type_name::<TFMessage>());
-    let imu_pub = peer.create_publisher::<Imu>(&imu_topic, None).unwrap();
-    let gnss_pub = peer
-        .create_publisher::<GnssMeasurements>(&gnss_topic, None)
-        .unwrap();
-    let odom_sub = peer
-        .create_subscription::<Odometry>(&odom_topic, None)
-        .unwrap();
-    let diag_sub = peer
-        .create_subscription::<DiagnosticArray>(&diag_topic, None)
-        .unwrap();
-    let tf_sub = peer
-        .create_subscription::<TFMessage>(&tf_topic, None)
-        .unwrap();
-    let spinner = peer.spinner().unwrap();
-    std::thread::spawn(move || smol::block_on(spinner.spin()));
-
-    // Discovery: both of our publishers matched by the node's subscriptions.
-    let matched = smol::block_on(async {
-        let wait = async {
-            imu_pub.wait_for_subscription(&peer).await;
-            gnss_pub.wait_for_subscription(&peer).await;
-            odom_sub.wait_for_publisher(&peer).await;
-            tf_sub.wait_for_publisher(&peer).await;
-            true
-        };
-        futures::select! {
-            ok = futures::FutureExt::fuse(wait) => ok,
-            _ = futures::FutureExt::fuse(smol::Timer::after(Duration::from_secs(20))) => false,
-        }
-    });
-    assert!(matched, "the node's topics were not discovered within 20 s");
+    let Peer {
+        node: _peer,
+        imu: imu_pub,
+        gnss: gnss_pub,
+        odometry: odom_sub,
+        diagnostics: diag_sub,
+        tf: tf_sub,
+        ..
+    } = Peer::matched(DOMAIN_ID, "stream_player", "/test/imu/data", false);
 
     // One bad IMU sample first: counted and dropped, the node stays up.
     let bad: Imu = outbound::imu(

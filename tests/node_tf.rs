@@ -8,22 +8,20 @@
 //! network namespace that has only loopback (tests/netns_support).
 
 mod netns_support;
+mod static_node_support;
 
-use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use adaptive_gnss_ins::ros::convert::seconds_to_time;
 use adaptive_gnss_ins::ros::msg::{
-    DiagnosticArray, GnssMeasurements, Header, Imu, Odometry, Quaternion, RosMessage, TFMessage,
-    Time, TransformStamped, Vector3,
+    DiagnosticArray, GnssMeasurements, Header, Odometry, Quaternion, TFMessage, Time,
+    TransformStamped, Vector3,
 };
 use adaptive_gnss_ins::ros::outbound;
-use adaptive_gnss_ins::sim::{Scenario, SimEvent};
+use adaptive_gnss_ins::sim::SimEvent;
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
-use netns_support::{reexec_in_private_netns, KillOnDrop};
-use ros2_client::{
-    Context, ContextOptions, MessageTypeName, Name, NodeName, NodeOptions, QosProfile,
-};
+use netns_support::reexec_in_private_netns;
+use static_node_support::{start_node, static_scenario, Peer};
 
 const DOMAIN_ID: u16 = 19;
 /// Scenario seconds streamed, and how much faster than real time.
@@ -42,11 +40,6 @@ const CONTROLLER_LEAD_NS: i64 = 200_000_000;
 /// (0.5 m/s × 20 ms = 1 cm), a wrong composition order, and an interpolated rotation
 /// left unnormalized (1.1e-9 m, measured here before the adapter renormalized it).
 const TOLERANCE: f64 = 1e-12;
-
-fn type_name<M: RosMessage>() -> MessageTypeName {
-    let parts: Vec<&str> = M::TYPE_NAME.split('/').collect();
-    MessageTypeName::new(parts[0], parts[2])
-}
 
 fn nanos(t: &Time) -> i64 {
     i64::from(t.sec) * 1_000_000_000 + i64::from(t.nanosec)
@@ -103,81 +96,22 @@ fn map_to_odom_chained_with_the_controllers_odom_is_the_fused_pose() {
     if reexec_in_private_netns("map_to_odom_chained_with_the_controllers_odom_is_the_fused_pose") {
         return;
     }
-    let scenario = Scenario::builtin("static", 3).unwrap();
-    let spec = &scenario.spec().trajectory;
-    let params = concat!(env!("CARGO_MANIFEST_DIR"), "/params/ekf.yaml");
-    let datum = format!(
-        "output.datum_llh_deg_m:=[{}, {}, {}]",
-        spec.start_lat_deg, spec.start_lon_deg, spec.start_height_m
+    let scenario = static_scenario();
+    let _node = start_node(
+        DOMAIN_ID,
+        &scenario,
+        &["-p", "publish_tf:=true", "-p", "tf_mode:=map_to_odom"],
     );
-    let node = Command::new(env!("CARGO_BIN_EXE_gnss_ins_node"))
-        .args(["--ros-args", "--params-file", params])
-        .args(["-p", "init.heading_deg:=0.0", "-p", &datum])
-        .args(["-r", "__ns:=/test"])
-        .args(["-p", "publish_tf:=true", "-p", "tf_mode:=map_to_odom"])
-        .args(["-p", "queue_depth:=500"])
-        .env("ROS_DOMAIN_ID", DOMAIN_ID.to_string())
-        .env("RUST_LOG", "info,rustdds=error,ros2_client=warn")
-        .stdin(Stdio::null())
-        .spawn()
-        .unwrap();
-    let _node = KillOnDrop(node);
-
-    let context = Context::with_options(ContextOptions::new().domain_id(DOMAIN_ID)).unwrap();
-    let mut peer = context
-        .new_node(
-            NodeName::new("/test", "base_controller").unwrap(),
-            NodeOptions::new()
-                .enable_rosout(false)
-                .start_parameter_services(false),
-        )
-        .unwrap();
-    let reliable = QosProfile::publisher_default()
-        .history(ros2_client::qos::History::KeepLast { depth: 20_000 });
-    let topic = |peer: &mut ros2_client::Node, name: &str, t: MessageTypeName| {
-        peer.create_topic(&Name::parse(name).unwrap(), t, &reliable)
-            .unwrap()
-    };
-    let imu_topic = topic(&mut peer, "/test/imu", type_name::<Imu>());
-    let gnss_topic = topic(
-        &mut peer,
-        "/test/gnss/measurements",
-        type_name::<GnssMeasurements>(),
-    );
-    let odom_topic = topic(&mut peer, "/test/odometry", type_name::<Odometry>());
-    let diag_topic = topic(&mut peer, "/diagnostics", type_name::<DiagnosticArray>());
-    let tf_topic = topic(&mut peer, "/tf", type_name::<TFMessage>());
-    let imu_pub = peer.create_publisher::<Imu>(&imu_topic, None).unwrap();
-    let gnss_pub = peer
-        .create_publisher::<GnssMeasurements>(&gnss_topic, None)
-        .unwrap();
-    let tf_pub = peer.create_publisher::<TFMessage>(&tf_topic, None).unwrap();
-    let odom_sub = peer
-        .create_subscription::<Odometry>(&odom_topic, None)
-        .unwrap();
-    let diag_sub = peer
-        .create_subscription::<DiagnosticArray>(&diag_topic, None)
-        .unwrap();
-    let tf_sub = peer
-        .create_subscription::<TFMessage>(&tf_topic, None)
-        .unwrap();
-    let spinner = peer.spinner().unwrap();
-    std::thread::spawn(move || smol::block_on(spinner.spin()));
-
-    let matched = smol::block_on(async {
-        let wait = async {
-            imu_pub.wait_for_subscription(&peer).await;
-            gnss_pub.wait_for_subscription(&peer).await;
-            tf_pub.wait_for_subscription(&peer).await;
-            odom_sub.wait_for_publisher(&peer).await;
-            true
-        };
-        futures::select! {
-            ok = futures::FutureExt::fuse(wait) => ok,
-            _ = futures::FutureExt::fuse(smol::Timer::after(Duration::from_secs(20))) => false,
-        }
-    });
-    assert!(matched, "the node's topics were not discovered within 20 s");
+    let Peer {
+        node: _peer,
+        imu: imu_pub,
+        gnss: gnss_pub,
+        tf_out,
+        odometry: odom_sub,
+        diagnostics: diag_sub,
+        tf: tf_sub,
+    } = Peer::matched(DOMAIN_ID, "base_controller", "/test/imu", true);
+    let tf_pub = tf_out.unwrap();
 
     let first_imu_ns = scenario
         .events()

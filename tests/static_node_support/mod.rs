@@ -1,0 +1,125 @@
+//! The set-up of the DDS tests that stream the simulated static receiver into the
+//! `gnss_ins_node` binary (node_ros, node_tf): the node on the ekf preset with the datum
+//! at the scenario's start and a known heading, and a ros2-client peer with the node's
+//! inputs and outputs, matched within 20 s. Call from inside the private network
+//! namespace (netns_support).
+#![allow(dead_code)]
+
+use std::process::{Command, Stdio};
+use std::time::Duration;
+
+use adaptive_gnss_ins::ros::msg::{
+    DiagnosticArray, GnssMeasurements, Imu, Odometry, RosMessage, TFMessage,
+};
+use adaptive_gnss_ins::sim::Scenario;
+use ros2_client::{
+    Context, ContextOptions, MessageTypeName, Name, NodeName, NodeOptions, Publisher, QosProfile,
+    Subscription,
+};
+
+use crate::netns_support::KillOnDrop;
+
+/// The scenario the node is started for.
+pub fn static_scenario() -> Scenario {
+    Scenario::builtin("static", 3).unwrap()
+}
+
+/// The node in namespace /test on `domain_id` for `scenario`, with `extra` ROS arguments
+/// (`-r`, `-p`) after the preset's.
+pub fn start_node(domain_id: u16, scenario: &Scenario, extra: &[&str]) -> KillOnDrop {
+    let spec = &scenario.spec().trajectory;
+    let params = concat!(env!("CARGO_MANIFEST_DIR"), "/params/ekf.yaml");
+    let datum = format!(
+        "output.datum_llh_deg_m:=[{}, {}, {}]",
+        spec.start_lat_deg, spec.start_lon_deg, spec.start_height_m
+    );
+    let node = Command::new(env!("CARGO_BIN_EXE_gnss_ins_node"))
+        .args(["--ros-args", "--params-file", params])
+        .args(["-p", "init.heading_deg:=0.0", "-p", &datum])
+        .args(["-r", "__ns:=/test", "-p", "queue_depth:=500"])
+        .args(extra)
+        .env("ROS_DOMAIN_ID", domain_id.to_string())
+        .env("RUST_LOG", "info,rustdds=error,ros2_client=warn")
+        .stdin(Stdio::null())
+        .spawn()
+        .unwrap();
+    KillOnDrop(node)
+}
+
+fn type_name<M: RosMessage>() -> MessageTypeName {
+    let parts: Vec<&str> = M::TYPE_NAME.split('/').collect();
+    MessageTypeName::new(parts[0], parts[2])
+}
+
+/// The test's participant: publishers of the node's inputs, subscriptions of its outputs.
+pub struct Peer {
+    pub node: ros2_client::Node,
+    pub imu: Publisher<Imu>,
+    pub gnss: Publisher<GnssMeasurements>,
+    /// On /tf, for a peer that stands in for a base controller.
+    pub tf_out: Option<Publisher<TFMessage>>,
+    pub odometry: Subscription<Odometry>,
+    pub diagnostics: Subscription<DiagnosticArray>,
+    pub tf: Subscription<TFMessage>,
+}
+
+impl Peer {
+    /// A peer called `name` in /test on `domain_id`, publishing the IMU on `imu_topic`
+    /// (and on /tf when `publishes_tf`), spinning, and matched with the node within 20 s
+    /// (panics otherwise).
+    pub fn matched(domain_id: u16, name: &str, imu_topic: &str, publishes_tf: bool) -> Peer {
+        let context = Context::with_options(ContextOptions::new().domain_id(domain_id)).unwrap();
+        let mut node = context
+            .new_node(
+                NodeName::new("/test", name).unwrap(),
+                NodeOptions::new()
+                    .enable_rosout(false)
+                    .start_parameter_services(false),
+            )
+            .unwrap();
+        let reliable = QosProfile::publisher_default()
+            .history(ros2_client::qos::History::KeepLast { depth: 20_000 });
+        let topic = |node: &mut ros2_client::Node, name: &str, t: MessageTypeName| {
+            node.create_topic(&Name::parse(name).unwrap(), t, &reliable)
+                .unwrap()
+        };
+        let imu_topic = topic(&mut node, imu_topic, type_name::<Imu>());
+        let gnss_topic = topic(
+            &mut node,
+            "/test/gnss/measurements",
+            type_name::<GnssMeasurements>(),
+        );
+        let odom_topic = topic(&mut node, "/test/odometry", type_name::<Odometry>());
+        let diag_topic = topic(&mut node, "/diagnostics", type_name::<DiagnosticArray>());
+        let tf_topic = topic(&mut node, "/tf", type_name::<TFMessage>());
+        let mut peer = Peer {
+            imu: node.create_publisher(&imu_topic, None).unwrap(),
+            gnss: node.create_publisher(&gnss_topic, None).unwrap(),
+            tf_out: publishes_tf.then(|| node.create_publisher(&tf_topic, None).unwrap()),
+            odometry: node.create_subscription(&odom_topic, None).unwrap(),
+            diagnostics: node.create_subscription(&diag_topic, None).unwrap(),
+            tf: node.create_subscription(&tf_topic, None).unwrap(),
+            node,
+        };
+        let spinner = peer.node.spinner().unwrap();
+        std::thread::spawn(move || smol::block_on(spinner.spin()));
+        let matched = smol::block_on(async {
+            let wait = async {
+                peer.imu.wait_for_subscription(&peer.node).await;
+                peer.gnss.wait_for_subscription(&peer.node).await;
+                if let Some(tf_out) = &peer.tf_out {
+                    tf_out.wait_for_subscription(&peer.node).await;
+                }
+                peer.odometry.wait_for_publisher(&peer.node).await;
+                peer.tf.wait_for_publisher(&peer.node).await;
+                true
+            };
+            futures::select! {
+                ok = futures::FutureExt::fuse(wait) => ok,
+                _ = futures::FutureExt::fuse(smol::Timer::after(Duration::from_secs(20))) => false,
+            }
+        });
+        assert!(matched, "the node's topics were not discovered within 20 s");
+        peer
+    }
+}
