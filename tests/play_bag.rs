@@ -292,3 +292,138 @@ fn node_records_the_replay_solution(
     assert!(worst <= 1e-9, "node and replay differ by {worst}");
     result
 }
+
+/// A drive for joining in its middle: 10 s at rest, then 10 m/s in a steady turn of 3 deg/s
+/// from 20 to 60 s, cruising and turning again; tactical IMU, 1 Hz GNSS, open sky.
+const MID_DRIVE_SCENARIO: &str = "
+name: mid_drive
+trajectory:
+  start_lat_deg: 39.10
+  start_lon_deg: 117.20
+  start_height_m: 10.0
+  start_yaw_deg: 90.0
+  transition_s: 2.0
+  segments:
+    - { kind: stationary, duration_s: 10.0 }
+    - { kind: speed_to, duration_s: 10.0, speed_m_s: 10.0 }
+    - { kind: turn, duration_s: 40.0, yaw_change_deg: 120.0 }
+    - { kind: cruise, duration_s: 40.0 }
+    - { kind: turn, duration_s: 20.0, yaw_change_deg: -60.0 }
+    - { kind: cruise, duration_s: 20.0 }
+truth_rate_hz: 5.0
+imu:
+  rate_hz: 100.0
+gnss:
+  rate_hz: 1.0
+  start_gps_s: 10800.0
+environments: []
+";
+/// Where the player joins the drive: in the steady turn at 10 m/s.
+const JOIN_AT_S: &str = "30";
+/// How long after the first played message the node must have converged (issue 11).
+const CONVERGED_AFTER_S: f64 = 60.0;
+
+fn yaw_rad(o: &Odometry) -> f64 {
+    let q = &o.pose.pose.orientation;
+    (2.0 * (q.w * q.z + q.x * q.y)).atan2(1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+}
+
+fn stamp_ns(o: &Odometry) -> i64 {
+    i64::from(o.header.stamp.sec) * 1_000_000_000 + i64::from(o.header.stamp.nanosec)
+}
+
+/// Issue 11: a bag played into the node from its middle (a re-launch during a drive:
+/// moving at 10 m/s in a turn, no rest to level on) converges as a start at rest does:
+/// from 60 s after the first message on, every solution at a truth epoch is within 3
+/// sigma of the truth in position and within 1 deg in yaw.
+#[test]
+fn node_joining_a_drive_in_its_middle_converges_to_the_truth() {
+    if reexec_in_private_netns("node_joining_a_drive_in_its_middle_converges_to_the_truth") {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let bag = dir.path().join("mid_drive.mcap");
+    let recorded = dir.path().join("node.mcap");
+    let scenario = Scenario::new(ScenarioSpec::from_yaml(MID_DRIVE_SCENARIO).unwrap(), 5).unwrap();
+    simulate_with(&scenario, &bag, SimulateOptions { velocity: false }).unwrap();
+    let spec = &scenario.spec().trajectory;
+    let datum = format!(
+        "output.datum_llh_deg_m:=[{}, {}, {}]",
+        spec.start_lat_deg, spec.start_lon_deg, spec.start_height_m
+    );
+    let domain = (DOMAIN_ID + 3).to_string();
+    let node = Command::new(env!("CARGO_BIN_EXE_gnss_ins_node"))
+        .arg("--record")
+        .arg(&recorded)
+        .args(["--ros-args", "-r", "__node:=mid_drive_test", "-p", &datum])
+        .env("ROS_DOMAIN_ID", &domain)
+        .env("RUST_LOG", "info,rustdds=error,ros2_client=warn")
+        .spawn()
+        .unwrap();
+    let status = Command::new(env!("CARGO_BIN_EXE_gnss_ins"))
+        .arg("play")
+        .arg(&bag)
+        .args(["--rate", "5", "--start-offset", JOIN_AT_S])
+        .args(["--wait-for", "/imu", "--wait-for", "/gnss/measurements"])
+        .args(["--delay", PLAYER_DELAY_S])
+        .env("ROS_DOMAIN_ID", &domain)
+        .env("RUST_LOG", "warn,rustdds=error")
+        .stdout(Stdio::null())
+        .status()
+        .unwrap();
+    assert!(status.success(), "gnss_ins play failed: {status}");
+    std::thread::sleep(Duration::from_secs(1));
+    let kill = Command::new("kill")
+        .args(["-INT", &node.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let mut node = node;
+    assert!(
+        node.wait().unwrap().success(),
+        "the node did not stop cleanly"
+    );
+
+    let truth: std::collections::HashMap<i64, Odometry> =
+        decoded::<Odometry>(&bag, "/ground_truth")
+            .into_iter()
+            .map(|o| (stamp_ns(&o), o))
+            .collect();
+    let live = decoded::<Odometry>(&recorded, "/odometry");
+    let join_ns = (JOIN_AT_S.parse::<f64>().unwrap() * 1e9) as i64;
+    let first_ns = stamp_ns(live.first().expect("the node published no Odometry"));
+    assert!(
+        first_ns >= join_ns,
+        "a solution before the join: {first_ns} ns"
+    );
+    let (mut judged, mut worst_sigmas, mut worst_yaw_deg) = (0, 0.0f64, 0.0f64);
+    for o in &live {
+        let t_ns = stamp_ns(o);
+        if t_ns < join_ns + (CONVERGED_AFTER_S * 1e9) as i64 {
+            continue;
+        }
+        let Some(true_o) = truth.get(&t_ns) else {
+            continue;
+        };
+        let (p, q) = (&o.pose.pose.position, &true_o.pose.pose.position);
+        let error_m = ((p.x - q.x).powi(2) + (p.y - q.y).powi(2) + (p.z - q.z).powi(2)).sqrt();
+        let c = &o.pose.covariance;
+        let sigma_m = (c[0] + c[7] + c[14]).sqrt();
+        let yaw_deg = (yaw_rad(o) - yaw_rad(true_o))
+            .sin()
+            .atan2((yaw_rad(o) - yaw_rad(true_o)).cos())
+            .to_degrees()
+            .abs();
+        worst_sigmas = worst_sigmas.max(error_m / sigma_m);
+        worst_yaw_deg = worst_yaw_deg.max(yaw_deg);
+        judged += 1;
+    }
+    println!(
+        "joined at {JOIN_AT_S} s: {} solutions, {judged} judged from {CONVERGED_AFTER_S} s \
+         on; worst position error {worst_sigmas:.2} sigma, worst yaw error {worst_yaw_deg:.3} deg",
+        live.len()
+    );
+    assert!(judged > 200, "only {judged} solutions at truth epochs");
+    assert!(worst_sigmas <= 3.0, "position {worst_sigmas} sigma off");
+    assert!(worst_yaw_deg < 1.0, "yaw {worst_yaw_deg} deg off");
+}

@@ -63,6 +63,9 @@ pub struct PlayOptions {
     pub repeat: bool,
     /// Wall time to wait after the publishers are created, before the first message.
     pub delay: Duration,
+    /// Bag time skipped at the start of each pass (`ros2 bag play --start-offset`): a
+    /// recording joined in its middle, as after a crash or a re-launch.
+    pub start_offset: Duration,
     /// Topics that must have a matched subscriber before playing starts.
     pub wait_for_topics: Vec<String>,
     /// DDS domain (`ROS_DOMAIN_ID`).
@@ -316,7 +319,9 @@ fn play_once(
     report: &mut PlayReport,
 ) -> Result<(), PlayError> {
     let started = Instant::now();
+    let mut bag_start_ns = None;
     let mut first_ns = None;
+    let offset_ns = u64::try_from(options.start_offset.as_nanos()).unwrap_or(u64::MAX);
     let mut last_clock_ns: Option<u64> = None;
     let clock_period_ns = if options.clock {
         (1e9 / options.clock_hz) as u64
@@ -340,6 +345,10 @@ fn play_once(
                 break;
             }
         };
+        let bag_start = *bag_start_ns.get_or_insert(log_time_ns);
+        if log_time_ns < bag_start.saturating_add(offset_ns) {
+            continue;
+        }
         let first = *first_ns.get_or_insert(log_time_ns);
         let since_start = Duration::from_nanos(log_time_ns.saturating_sub(first));
         let due = started + release_offset(since_start, options.rate);
@@ -416,6 +425,7 @@ mod tests {
             clock_hz,
             repeat: false,
             delay: Duration::ZERO,
+            start_offset: Duration::ZERO,
             wait_for_topics: Vec::new(),
             domain_id: 0,
         };

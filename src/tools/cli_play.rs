@@ -27,6 +27,10 @@ pub struct PlayArgs {
     /// Seconds to wait after creating the publishers, before the first message.
     #[arg(long, default_value_t = 0.0)]
     delay: f64,
+    /// Seconds of the bag to skip at its start (each pass with --loop): join a recording
+    /// in its middle, as after a crash or a re-launch.
+    #[arg(long, default_value_t = 0.0)]
+    start_offset: f64,
     /// A topic that must have a matched subscriber before playing starts (repeatable).
     #[arg(long = "wait-for")]
     wait_for: Vec<String>,
@@ -41,12 +45,19 @@ pub fn play(args: PlayArgs) -> Result<(), String> {
             args.delay
         )
     })?;
+    let start_offset = Duration::try_from_secs_f64(args.start_offset).map_err(|_| {
+        format!(
+            "--start-offset must be a non-negative number of seconds, got {}",
+            args.start_offset
+        )
+    })?;
     let options = PlayOptions {
         rate: args.rate,
         clock: args.clock,
         clock_hz: args.clock_hz,
         repeat: args.repeat,
         delay,
+        start_offset,
         wait_for_topics: args.wait_for,
         domain_id,
     };
