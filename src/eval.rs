@@ -4,6 +4,7 @@
 
 use nalgebra::{SMatrix, SVector, UnitQuaternion, Vector3};
 
+use crate::adaptive::mahalanobis::chi_square_quantile;
 use crate::earth::{self, Llh};
 use crate::engine::Solution;
 use crate::ins::error_state::{DP, DV, PHI};
@@ -161,6 +162,10 @@ pub struct ErrorSummary {
     pub att_rmse_pitch_deg: f64,
     pub att_rmse_yaw_deg: f64,
     pub nees_mean: f64,
+    /// Fraction of the epochs with a NEES whose NEES lies inside its two-sided 95 % χ²
+    /// bounds for its degrees of freedom: about 0.95 for a covariance that states the
+    /// errors honestly, far less for an over-confident one (NaN without any NEES).
+    pub nees_in_bounds_95: f64,
 }
 
 fn rms(values: impl Iterator<Item = f64>) -> f64 {
@@ -212,6 +217,39 @@ pub fn summarize(errors: &[SolutionError]) -> ErrorSummary {
         } else {
             nees.iter().sum::<f64>() / nees.len() as f64
         },
+        nees_in_bounds_95: nees_in_bounds_95(errors),
+    }
+}
+
+/// See [`ErrorSummary::nees_in_bounds_95`].
+fn nees_in_bounds_95(errors: &[SolutionError]) -> f64 {
+    let mut bounds: Vec<(usize, Option<(f64, f64)>)> = Vec::new();
+    let (mut judged, mut inside) = (0usize, 0usize);
+    for e in errors.iter().filter(|e| e.nees.is_finite()) {
+        let dof = e.nees_dof;
+        let bound = match bounds.iter().find(|(d, _)| *d == dof) {
+            Some((_, b)) => *b,
+            None => {
+                let b = match (
+                    chi_square_quantile(0.025, dof),
+                    chi_square_quantile(0.975, dof),
+                ) {
+                    (Ok(lo), Ok(hi)) => Some((lo, hi)),
+                    _ => None,
+                };
+                bounds.push((dof, b));
+                b
+            }
+        };
+        if let Some((lo, hi)) = bound {
+            judged += 1;
+            inside += usize::from((lo..=hi).contains(&e.nees));
+        }
+    }
+    if judged == 0 {
+        f64::NAN
+    } else {
+        inside as f64 / judged as f64
     }
 }
 
@@ -271,5 +309,30 @@ mod tests {
         assert!((s.vel_rmse_3d_mps - 2.0).abs() < 1e-12);
         assert!((s.att_rmse_yaw_deg - 1.0).abs() < 1e-12);
         assert!((s.nees_mean - 3.0).abs() < 1e-12);
+        // 3.0 lies inside [2.70, 19.02], the 95 % bounds of chi-square with 9 dof.
+        assert_eq!(s.nees_in_bounds_95, 1.0);
+    }
+
+    #[test]
+    fn nees_outside_the_95_percent_bounds_is_counted_per_degrees_of_freedom() {
+        let e = |nees: f64, nees_dof: usize| SolutionError {
+            t_s: 0.0,
+            position_enu_m: Vector3::zeros(),
+            velocity_enu_mps: None,
+            attitude_rpy_rad: None,
+            nees,
+            nees_dof,
+        };
+        // 3 dof: [0.216, 9.35]; 9 dof: [2.70, 19.02].
+        let errors = [
+            e(0.1, 3),
+            e(5.0, 3),
+            e(10.0, 3),
+            e(2.0, 9),
+            e(18.0, 9),
+            e(f64::NAN, 9),
+        ];
+        assert_eq!(summarize(&errors).nees_in_bounds_95, 2.0 / 5.0);
+        assert!(summarize(&[e(f64::NAN, 3)]).nees_in_bounds_95.is_nan());
     }
 }

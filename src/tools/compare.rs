@@ -297,6 +297,8 @@ pub struct EnvironmentRow {
     pub pos_rmse_u_m: f64,
     pub pos_rmse_3d_m: f64,
     pub vel_rmse_3d_mps: f64,
+    /// Fraction of the epochs whose NEES lies inside its 95 % χ² bounds.
+    pub nees_in_bounds_95: f64,
 }
 
 impl EnvironmentRow {
@@ -316,6 +318,7 @@ impl EnvironmentRow {
                 pos_rmse_u_m: s.pos_rmse_u_m,
                 pos_rmse_3d_m: s.pos_rmse_3d_m,
                 vel_rmse_3d_mps: s.vel_rmse_3d_mps,
+                nees_in_bounds_95: s.nees_in_bounds_95,
             })
             .collect()
     }
@@ -324,7 +327,7 @@ impl EnvironmentRow {
 /// The comparison by environment as an aligned text table.
 pub fn format_environment_table(rows: &[EnvironmentRow]) -> String {
     let mut out = format!(
-        "{:<14} {:<14} {:>7} {:>8} {:>12} {:>8} {:>8} {:>9}\n",
+        "{:<14} {:<14} {:>7} {:>8} {:>12} {:>8} {:>8} {:>9} {:>8}\n",
         "filter",
         "environment",
         "epochs",
@@ -332,11 +335,12 @@ pub fn format_environment_table(rows: &[EnvironmentRow]) -> String {
         "horiz_demean",
         "vert_m",
         "pos3d_m",
-        "vel_mps"
+        "vel_mps",
+        "nees_95"
     );
     for r in rows {
         out.push_str(&format!(
-            "{:<14} {:<14} {:>7} {:>8.3} {:>12.3} {:>8.3} {:>8.3} {:>9.4}\n",
+            "{:<14} {:<14} {:>7} {:>8.3} {:>12.3} {:>8.3} {:>8.3} {:>9.4} {:>8.3}\n",
             r.filter,
             r.environment,
             r.epochs,
@@ -344,7 +348,8 @@ pub fn format_environment_table(rows: &[EnvironmentRow]) -> String {
             r.pos_rmse_horizontal_offset_removed_m,
             r.pos_rmse_u_m,
             r.pos_rmse_3d_m,
-            r.vel_rmse_3d_mps
+            r.vel_rmse_3d_mps,
+            r.nees_in_bounds_95
         ));
     }
     out
