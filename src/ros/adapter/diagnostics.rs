@@ -6,7 +6,8 @@ use super::{RosAdapter, TfMode};
 
 impl RosAdapter {
     /// The /diagnostics report at `stamp`: input counts, constraint updates by kind,
-    /// rejections by reason, resets after a divergence, phase and, in `tf_mode`
+    /// rejections by reason, resets after a divergence, with `gnss.tdcp` the phase
+    /// changes used and left out by reason, phase and, in `tf_mode`
     /// `map_to_odom` the `odom → base` transforms heard and the Odometry messages without
     /// a `map → odom`, once running, the filter's 3D position sigma (level ERROR when it
     /// is not finite); level ERROR from a divergence until the filter runs again, WARN
@@ -35,6 +36,11 @@ impl RosAdapter {
             ("updates_non_holonomic", updates.non_holonomic),
         ] {
             values.push(key_value(key, n.to_string()));
+        }
+        if self.engine.config().gnss.tdcp {
+            for (key, n) in self.phases.named() {
+                values.push(key_value(&key, n.to_string()));
+            }
         }
         if self.outputs.frames().published_tf() == TfMode::MapToOdom {
             let odom = &self.outputs.odom;

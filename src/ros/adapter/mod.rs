@@ -34,6 +34,7 @@ mod guard;
 mod inputs;
 mod odom_tf;
 mod outputs;
+mod phase_counts;
 mod stamp_book;
 #[cfg(test)]
 mod tests;
@@ -49,6 +50,7 @@ use frame_lock::FrameLock;
 pub use inputs::InputMessage;
 pub use odom_tf::TfMode;
 pub use outputs::{OutputFrames, Published, PublishedEpoch, PublishedSolution, SolutionMessages};
+pub use phase_counts::PhaseCounts;
 use stamp_book::StampBook;
 use time_line::TimeLine;
 pub use time_line::{TIME_JUMP_BACK_S, TIME_JUMP_CONFIRM_SAMPLES};
@@ -68,6 +70,8 @@ pub struct RosAdapter {
     imu_stamps: StampBook,
     /// The stamps of the GNSS epochs and fixes, which their reports carry.
     measurement_stamps: StampBook,
+    /// What the carrier-phase updates did with the phase changes.
+    phases: PhaseCounts,
 }
 
 impl RosAdapter {
@@ -85,6 +89,7 @@ impl RosAdapter {
             fix_frame: FrameLock::default(),
             imu_stamps: StampBook::default(),
             measurement_stamps: StampBook::default(),
+            phases: PhaseCounts::default(),
         }
     }
 
@@ -117,6 +122,11 @@ impl RosAdapter {
     /// [`Engine::retune`]); the filter keeps running.
     pub fn retune(&mut self, config: Config) -> Result<(), NotRuntimeTunable> {
         self.engine.retune(config)
+    }
+
+    /// What the carrier-phase updates did with the phase changes (`gnss.tdcp`).
+    pub fn phase_counts(&self) -> &PhaseCounts {
+        &self.phases
     }
 
     /// Velocities dropped for want of a fix of their stamp.

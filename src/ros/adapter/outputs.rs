@@ -262,6 +262,7 @@ impl RosAdapter {
                 }
                 Output::Epoch(report) => {
                     self.outputs.used(&report);
+                    self.phases.add(&report);
                     if let Ok(stamp) = self.measurement_stamps.stamp(report.t_s) {
                         let noise = outbound::noise_estimates(
                             &report,

@@ -792,3 +792,59 @@ fn a_divergence_is_an_error_on_diagnostics_until_the_filter_runs_again() {
         level(&adapter)
     );
 }
+
+/// Issue 15: with `gnss.tdcp` the phase changes used and left out show on /diagnostics;
+/// a satellite whose half cycle is never resolved is counted under its reason every
+/// epoch, and without `gnss.tdcp` there are no such keys.
+#[test]
+fn carrier_phase_changes_used_and_left_out_are_counted_on_diagnostics() {
+    use crate::ros::msg::SatelliteMeasurement;
+    use crate::sim::SimEvent;
+    let run = |tdcp: bool| {
+        let mut config = Config::default();
+        config
+            .set_parameter("gnss.tdcp", if tdcp { "true" } else { "false" })
+            .unwrap();
+        // At rest the heading is not observable: the static scenario's is given.
+        config.set_parameter("init.heading_deg", "0.0").unwrap();
+        let mut adapter = RosAdapter::new(config, OutputFrames::default());
+        let mut epochs = 0u64;
+        for_each_static_event_30_s(|event, stamp| {
+            match event {
+                SimEvent::Imu(s) => adapter.on_imu(&outbound::imu(&s, stamp, "imu")),
+                SimEvent::Gnss { epoch, .. } => {
+                    let mut msg = outbound::gnss_measurements(&epoch, 0, stamp, "gnss");
+                    if let Some(first) = msg.satellites.first_mut() {
+                        first.carrier_phase_flags |=
+                            SatelliteMeasurement::CARRIER_HALF_CYCLE_UNRESOLVED;
+                    }
+                    epochs += 1;
+                    adapter.on_gnss(&msg)
+                }
+                _ => Vec::new(),
+            };
+        });
+        assert_eq!(adapter.engine().init_phase(), None, "running");
+        (adapter, epochs)
+    };
+    let (adapter, epochs) = run(true);
+    let count = |key: &str| {
+        diagnostic(&adapter, key)
+            .unwrap_or_else(|| panic!("no {key}"))
+            .parse::<u64>()
+            .unwrap()
+    };
+    let used = count("tdcp_phases_used");
+    let half_cycle = count("tdcp_rejected_half_cycle_unresolved");
+    assert!(
+        used > 5 * half_cycle,
+        "used {used}, half cycle {half_cycle}"
+    );
+    assert!(
+        half_cycle > epochs / 2 && half_cycle <= epochs,
+        "half cycle {half_cycle} of {epochs} epochs"
+    );
+    assert_eq!(adapter.phase_counts().used, used);
+    let (adapter, _) = run(false);
+    assert_eq!(diagnostic(&adapter, "tdcp_phases_used"), None);
+}
