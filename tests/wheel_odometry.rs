@@ -13,13 +13,12 @@
 //!   rejected and counted, and the run is identical to the bit to one without them.
 //! - `wheel_odometry.scale_factor` undoes a wheel radius error.
 
-use std::path::{Path, PathBuf};
+mod car_outage_support;
 
 use adaptive_gnss_ins::config::{Config, Platform};
 use adaptive_gnss_ins::engine::{RejectionCounters, RejectionReason};
 use adaptive_gnss_ins::eval::SolutionError;
-use adaptive_gnss_ins::ros::node::params::config_from_files;
-use adaptive_gnss_ins::sim::{Scenario, ScenarioSpec};
+use adaptive_gnss_ins::sim::Scenario;
 use adaptive_gnss_ins::tools::scenario_inputs::scenario_inputs;
 use adaptive_gnss_ins::tools::scoring::Reference;
 use adaptive_gnss_ins::tools::session::{Session, SessionInput};
@@ -27,29 +26,13 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 
-const SEED: u64 = 1;
-/// The car's outage (tests/data/consumer_mems_car_outage.yaml) and its speed.
-const OUTAGE_START_S: f64 = 145.0;
-const OUTAGE_END_S: f64 = 175.0;
-const OUTAGE_SPEED_MPS: f64 = 12.0;
+use car_outage_support::{
+    at_outage_end_m, consumer_mems_loose, outage_distance_m, spec, CAR_OUTAGE, MAX_ERROR_FRACTION,
+    SEED,
+};
+
 /// The wheel speed's white noise (m/s), given with each speed as its σ.
 const WHEEL_SIGMA_MPS: f64 = 0.05;
-/// Issue 14's figure: the horizontal error at the outage's end as a fraction of the
-/// distance travelled in it.
-const MAX_ERROR_FRACTION: f64 = 0.01;
-
-fn repo(path: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(path)
-}
-
-fn consumer_mems_loose() -> Config {
-    config_from_files(&[
-        repo("params/ekf.yaml"),
-        repo("params/ekf_loose.yaml"),
-        repo("params/imu_consumer_mems.yaml"),
-    ])
-    .unwrap()
-}
 
 fn with_wheels(mut config: Config) -> Config {
     config.wheel_odometry.enabled = true;
@@ -84,11 +67,7 @@ const BAD: [(f64, f64, Option<f64>); 6] = [
 /// The car's drive with `config` and `wheels`: its solution errors and the engine's
 /// rejections.
 fn drive(config: Config, wheels: Wheels) -> (Vec<SolutionError>, RejectionCounters) {
-    let spec = ScenarioSpec::from_yaml(
-        &std::fs::read_to_string(repo("tests/data/consumer_mems_car_outage.yaml")).unwrap(),
-    )
-    .unwrap();
-    let scenario = Scenario::new(spec, SEED).unwrap();
+    let scenario = Scenario::new(spec(CAR_OUTAGE), SEED).unwrap();
     let mut session = Session::new(config, 0.0, None);
     let mut rng = ChaCha8Rng::seed_from_u64(SEED);
     let noise = Normal::new(0.0, WHEEL_SIGMA_MPS).unwrap();
@@ -133,19 +112,6 @@ fn drive(config: Config, wheels: Wheels) -> (Vec<SolutionError>, RejectionCounte
     (errors, counters)
 }
 
-/// The horizontal error scored nearest to the outage's end.
-fn at_outage_end_m(errors: &[SolutionError]) -> f64 {
-    let e = errors
-        .iter()
-        .min_by(|a, b| {
-            (a.t_s - OUTAGE_END_S)
-                .abs()
-                .total_cmp(&(b.t_s - OUTAGE_END_S).abs())
-        })
-        .unwrap();
-    e.position_enu_m.xy().norm()
-}
-
 #[test]
 fn wheel_speeds_bound_a_cars_outage() {
     let error_m = |config: Config, wheels: Wheels| at_outage_end_m(&drive(config, wheels).0);
@@ -153,7 +119,7 @@ fn wheel_speeds_bound_a_cars_outage() {
     let wheels_m = error_m(with_wheels(consumer_mems_loose()), Wheels::Speeds);
     let nhc_m = error_m(car(consumer_mems_loose()), Wheels::None);
     let nhc_wheels_m = error_m(car(with_wheels(consumer_mems_loose())), Wheels::Speeds);
-    let distance_m = OUTAGE_SPEED_MPS * (OUTAGE_END_S - OUTAGE_START_S);
+    let distance_m = outage_distance_m();
     println!(
         "horizontal error at the outage's end ({distance_m} m travelled): free inertial \
          {free_m:.2} m, wheel speed {wheels_m:.2} m ({:.2} %); NHC {nhc_m:.2} m, NHC and \
