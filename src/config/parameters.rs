@@ -213,9 +213,10 @@ parameter_table! {
     /// Wheel odometry (optional): the base controller's forward speed (nav_msgs/Odometry
     /// on wheel/odometry, twist.twist.linear.x in its child frame) measures the forward
     /// velocity, in the body frame, of the point mounting.constraint_point_lever_arm_m
-    /// (the middle of the driven axle).
+    /// (the middle of the axle whose wheels the controller reads, as for the NHC).
     section wheel_odometry: WheelOdometryConfig {
-        /// Use the wheel speeds; when off they are rejected and counted.
+        /// Use the wheel speeds (the node subscribes wheel/odometry only then); when off,
+        /// speeds given to the engine are rejected and counted.
         enabled: bool = false, unit "", range ANY, at_start;
         /// 1-sigma of a speed whose message gives no variance (twist covariance[0] 0).
         sigma_mps: f64 = 0.1, unit "m/s", range SIGMA, at_start;
