@@ -211,21 +211,20 @@ impl RosAdapter {
             Admission::Foreign => return self.foreign_frame(Input::WheelOdometry, frame_id),
             Admission::Switched => self.frame_switched(Input::WheelOdometry, frame_id),
         }
-        let outputs =
-            match self
-                .engine
-                .push_wheel_speed(speed.t_s, speed.speed_mps, speed.sigma_mps)
-            {
-                Ok(o) => {
-                    self.wheel_frame.accepted(frame_id);
-                    o
-                }
-                Err(e) => {
-                    self.log
-                        .warn(e.reason.name(), &format!("wheel odometry: {e}"));
-                    Vec::new()
-                }
-            };
+        let pushed = self
+            .engine
+            .push_wheel_speed(speed.t_s, speed.speed_mps, speed.sigma_mps);
+        let outputs = match pushed {
+            Ok(o) => {
+                self.wheel_frame.accepted(frame_id);
+                o
+            }
+            Err(e) => {
+                self.log
+                    .warn(e.reason.name(), &format!("wheel odometry: {e}"));
+                Vec::new()
+            }
+        };
         self.publishable(outputs)
     }
 

@@ -5,11 +5,12 @@
 //! (sensor_msgs/Imu), `gnss/measurements` (GnssMeasurements), `gnss/fix` (NavSatFix),
 //! `gnss/velocity` (TwistWithCovarianceStamped), with `wheel_odometry.enabled`
 //! `wheel/odometry` (nav_msgs/Odometry of the base controller), `/clock`
-//! (rosgraph_msgs/Clock, for `use_sim_time`); publishes `odometry` (nav_msgs/Odometry, `map_frame` → `base_frame`),
-//! `fix/filtered` (NavSatFix), `~/noise_estimates` (NoiseEstimates), `/diagnostics`
-//! (DiagnosticArray, 1 Hz), `/rosout` (rcl_interfaces/Log), `/parameter_events`
-//! (rcl_interfaces/ParameterEvent: each parameter declared at the start, then each
-//! accepted set, as rclcpp announces them) and, with `publish_tf`, `/tf`
+//! (rosgraph_msgs/Clock, for `use_sim_time`); publishes `odometry` (nav_msgs/Odometry,
+//! `map_frame` → `base_frame`), `fix/filtered` (NavSatFix), `~/noise_estimates`
+//! (NoiseEstimates), `/diagnostics` (DiagnosticArray, 1 Hz), `/rosout`
+//! (rcl_interfaces/Log), `/parameter_events` (rcl_interfaces/ParameterEvent: each
+//! parameter declared at the start, then each accepted set, as rclcpp announces them)
+//! and, with `publish_tf`, `/tf`
 //! (tf2_msgs/TFMessage: `map_frame → base_frame`, or in `tf_mode` `map_to_odom`
 //! `map_frame → odom_frame`, for which it also subscribes `/tf` to hear the base
 //! controller's `odom_frame → base_frame`). Serves the parameter services ([`services`]).
