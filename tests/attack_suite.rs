@@ -235,6 +235,7 @@ fn header_of(message: &mut InputMessage) -> &mut adaptive_gnss_ins::ros::msg::He
         InputMessage::Gnss(m) => &mut m.header,
         InputMessage::Fix(m) => &mut m.header,
         InputMessage::Velocity(m) => &mut m.header,
+        InputMessage::WheelOdometry(m) => &mut m.header,
     }
 }
 

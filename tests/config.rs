@@ -84,6 +84,10 @@ const EVERY_KEY_CHANGED: &str = "
       nhc_sigma_lateral_mps: 0.2
       nhc_sigma_vertical_mps: 0.3
       nhc_yaw_rate_max_deg_per_s: 45.0
+    wheel_odometry:
+      enabled: true
+      sigma_mps: 0.04
+      scale_factor: 1.02
     clock:
       bias_noise_m_per_sqrt_s: 0.7
       drift_noise_mps_per_sqrt_s: 0.03

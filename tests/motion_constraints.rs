@@ -13,42 +13,25 @@
 //! - a pedestrian's platform adds no constraint: the same replay with platform pedestrian
 //!   and none is identical to the bit.
 
-use std::path::{Path, PathBuf};
+mod car_outage_support;
 
 use adaptive_gnss_ins::config::{Config, Platform};
 use adaptive_gnss_ins::eval::SolutionError;
-use adaptive_gnss_ins::ros::node::params::config_from_files;
 use adaptive_gnss_ins::sim::{Scenario, ScenarioSpec, Segment};
 use adaptive_gnss_ins::tools::compare::{compare_bag, NamedConfig};
 use adaptive_gnss_ins::tools::simulate::{simulate_with, SimulateOptions, TRUTH_TOPIC};
 
-const SEED: u64 = 1;
-/// The car's outage (tests/data/consumer_mems_car_outage.yaml) and its speed.
-const OUTAGE_START_S: f64 = 145.0;
-const OUTAGE_END_S: f64 = 175.0;
-const OUTAGE_SPEED_MPS: f64 = 12.0;
-/// Issue 14's figure: the horizontal error at the outage's end with NHC, as a fraction of
-/// the distance travelled in it.
-const NHC_MAX_ERROR_FRACTION: f64 = 0.01;
+use car_outage_support::{
+    at, at_outage_end_m, consumer_mems_loose, outage_distance_m, spec, CAR_OUTAGE,
+    MAX_ERROR_FRACTION, SEED,
+};
+
 /// When the parked car's GNSS goes (tests/data/consumer_mems_parked.yaml), 5 s after it
 /// stopped.
 const PARKED_FROM_S: f64 = 150.0;
 /// Issue 14's figures for a standstill with ZUPT.
 const PARKED_MAX_DRIFT_M: f64 = 0.5;
 const PARKED_MAX_HEADING_DRIFT_DEG: f64 = 1.0;
-
-fn repo(path: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(path)
-}
-
-fn consumer_mems_loose() -> Config {
-    config_from_files(&[
-        repo("params/ekf.yaml"),
-        repo("params/ekf_loose.yaml"),
-        repo("params/imu_consumer_mems.yaml"),
-    ])
-    .unwrap()
-}
 
 /// The solution errors of each configuration on the scenario `spec`.
 fn replay(spec: ScenarioSpec, configs: &[(&str, Config)]) -> Vec<Vec<SolutionError>> {
@@ -70,45 +53,29 @@ fn replay(spec: ScenarioSpec, configs: &[(&str, Config)]) -> Vec<Vec<SolutionErr
         .collect()
 }
 
-fn spec(file: &str) -> ScenarioSpec {
-    ScenarioSpec::from_yaml(&std::fs::read_to_string(repo(file)).unwrap()).unwrap()
-}
-
-/// The error scored nearest to `t_s`.
-fn at(errors: &[SolutionError], t_s: f64) -> &SolutionError {
-    errors
-        .iter()
-        .min_by(|a, b| (a.t_s - t_s).abs().total_cmp(&(b.t_s - t_s).abs()))
-        .unwrap()
-}
-
-fn horizontal_m(e: &SolutionError) -> f64 {
-    e.position_enu_m.xy().norm()
-}
-
 #[test]
 fn the_non_holonomic_constraint_bounds_a_cars_outage() {
     let mut car = consumer_mems_loose();
     car.constraints.platform = Platform::Car;
     let runs = replay(
-        spec("tests/data/consumer_mems_car_outage.yaml"),
+        spec(CAR_OUTAGE),
         &[("nhc", car), ("free", consumer_mems_loose())],
     );
-    let distance_m = OUTAGE_SPEED_MPS * (OUTAGE_END_S - OUTAGE_START_S);
-    let nhc_m = horizontal_m(at(&runs[0], OUTAGE_END_S));
-    let free_m = horizontal_m(at(&runs[1], OUTAGE_END_S));
+    let distance_m = outage_distance_m();
+    let nhc_m = at_outage_end_m(&runs[0]);
+    let free_m = at_outage_end_m(&runs[1]);
     println!(
         "horizontal error at the outage's end ({distance_m} m travelled): NHC {nhc_m:.2} m \
          ({:.2} %), free inertial {free_m:.2} m",
         100.0 * nhc_m / distance_m
     );
     assert!(
-        nhc_m <= NHC_MAX_ERROR_FRACTION * distance_m,
+        nhc_m <= MAX_ERROR_FRACTION * distance_m,
         "NHC: {nhc_m:.2} m"
     );
     // Without the constraint the same figure fails.
     assert!(
-        free_m > NHC_MAX_ERROR_FRACTION * distance_m,
+        free_m > MAX_ERROR_FRACTION * distance_m,
         "free inertial: {free_m:.2} m"
     );
 }
@@ -166,7 +133,7 @@ fn a_pedestrian_platform_adds_no_constraint() {
     let mut pedestrian = consumer_mems_loose();
     pedestrian.constraints.platform = Platform::Pedestrian;
     let runs = replay(
-        spec("tests/data/consumer_mems_car_outage.yaml"),
+        spec(CAR_OUTAGE),
         &[("pedestrian", pedestrian), ("none", consumer_mems_loose())],
     );
     assert!(!runs[0].is_empty());

@@ -5,14 +5,12 @@
 //! velocity better against the truth, and the result does not depend on whether each fix
 //! or its velocity comes first in the bag.
 
+mod bag_support;
+
 use std::path::{Path, PathBuf};
 
 use adaptive_gnss_ins::config::Config;
 use adaptive_gnss_ins::ros::bag::{BagReader, BagWriter};
-use adaptive_gnss_ins::ros::msg::{
-    DiagnosticArray, GnssMeasurements, Imu, NavSatFix, NoiseEstimates, Odometry,
-    TwistWithCovarianceStamped,
-};
 use adaptive_gnss_ins::sim::{Scenario, ScenarioSpec};
 use adaptive_gnss_ins::tools::bag_run::BagRun;
 use adaptive_gnss_ins::tools::replay::{replay, ReplayOptions, TruthSource};
@@ -108,24 +106,7 @@ fn replay_joins_every_velocity_with_its_fix_and_uses_it() {
 fn with_log_time_delayed(from: &Path, to: &Path, delayed: &str) {
     let reader = BagReader::open(from).unwrap();
     let mut writer = BagWriter::create(to).unwrap();
-    writer.add_topic::<Imu>(simulate::IMU_TOPIC).unwrap();
-    writer
-        .add_topic::<GnssMeasurements>(simulate::GNSS_TOPIC)
-        .unwrap();
-    writer.add_topic::<NavSatFix>(simulate::FIX_TOPIC).unwrap();
-    writer
-        .add_topic::<TwistWithCovarianceStamped>(simulate::VELOCITY_TOPIC)
-        .unwrap();
-    writer.add_topic::<Odometry>(simulate::TRUTH_TOPIC).unwrap();
-    writer
-        .add_topic::<NavSatFix>(simulate::TRUTH_DATUM_TOPIC)
-        .unwrap();
-    writer
-        .add_topic::<NoiseEstimates>(simulate::TRUTH_NOISE_TOPIC)
-        .unwrap();
-    writer
-        .add_topic::<DiagnosticArray>(simulate::TRUTH_ENVIRONMENT_TOPIC)
-        .unwrap();
+    bag_support::add_simulated_topics(&mut writer);
     let mut moved = 0;
     for m in reader.messages().unwrap() {
         let m = m.unwrap();

@@ -42,6 +42,7 @@ pub use param_file::{NodeParameters, MAX_FILE_BYTES};
 pub use parameters::{
     AdaptiveConfig, ClockConfig, Config, ConstraintsConfig, EngineConfig, FilterConfig, GnssConfig,
     ImuConfig, InitConfig, LooseConfig, MountingConfig, OutputConfig, RobustConfig,
+    WheelOdometryConfig,
 };
 pub use sections::{AdaptiveFactorKind, Coupling, EquivalentWeightKind, Platform};
 pub use spec::{Interval, Kind, Range};

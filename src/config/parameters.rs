@@ -210,6 +210,23 @@ parameter_table! {
             si Scale::to("rad/s", RAD_PER_DEG);
     }
 
+    /// Wheel odometry (optional): the base controller's forward speed (nav_msgs/Odometry
+    /// on wheel/odometry, twist.twist.linear.x in its child frame) measures the forward
+    /// velocity, in the body frame, of the point mounting.constraint_point_lever_arm_m
+    /// (the middle of the axle whose wheels the controller reads, as for the NHC).
+    section wheel_odometry: WheelOdometryConfig {
+        /// Use the wheel speeds (the node subscribes wheel/odometry only then); when off,
+        /// speeds given to the engine are rejected and counted.
+        enabled: bool = false, unit "", range ANY, at_start;
+        /// 1-sigma of a speed whose message gives no variance (twist covariance[0] 0).
+        sigma_mps: f64 = 0.1, unit "m/s", range SIGMA, at_start;
+        /// Fixed factor from the reported speed to the true one (a wheel radius off by 1 %:
+        /// 1.01). Applied to the speed and its sigma; not estimated.
+        // Choice: within [0.5, 2]: a factor beyond is a wrong unit or wheel, not a tyre.
+        scale_factor: f64 = 1.0,
+            unit "", range Range::Within(Interval::closed(0.5, 2.0)), at_start;
+    }
+
     /// Receiver clock model: bias c*dt_u (m) and drift c*dt_ru (m/s). The defaults are a
     /// typical TCXO (Allan coefficients h0 = 2e-19, h-2 = 2e-20, Brown & Hwang):
     /// sqrt(h0/2)*c = 0.1 m/sqrt(s), sqrt(2 pi^2 h-2)*c = 0.2 (m/s)/sqrt(s).

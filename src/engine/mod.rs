@@ -20,6 +20,9 @@
 //!   more than `engine.imu_buffer_s` ahead of the IMU.
 //! - Every buffer is bounded by count as well as by time ([`MAX_BUFFERED_IMU_SAMPLES`],
 //!   [`MAX_PENDING_MEASUREMENTS`]), so no input rate or stamp grows memory without bound.
+//! - Wheel speeds (`wheel_odometry.*`, [`wheel_odometry`]) take the measurements' path
+//!   (waiting, roll-back, duplicates by kind) while the filter runs; before, start-up has
+//!   no use for them and they are rejected and counted.
 //! - Start-up (`initializer`): levelled at rest, or aligned in motion from GNSS when
 //!   the IMU's window is not at rest (a start or a restart mid-drive); a start whose
 //!   heading is too uncertain for one filter runs a bank of heading hypotheses first
@@ -49,6 +52,7 @@ mod retune;
 pub mod standstill;
 mod start_up;
 pub mod update;
+mod wheel_odometry;
 
 use std::collections::VecDeque;
 
@@ -62,6 +66,7 @@ use divergence::DivergenceMonitor;
 use heading_bank::HeadingBank;
 use imu_screen::{ImuScreen, Screened};
 use standstill::StandstillDetector;
+use wheel_odometry::WheelSpeedReading;
 
 pub use adaptation::Adaptation;
 pub use constraints::ConstraintUpdates;
@@ -108,6 +113,7 @@ pub struct Buffered {
 enum Measurement {
     Gnss(GnssEpoch),
     Fix(GnssFix),
+    WheelSpeed(WheelSpeedReading),
 }
 
 impl Measurement {
@@ -115,7 +121,13 @@ impl Measurement {
         match self {
             Self::Gnss(e) => e.t_s,
             Self::Fix(f) => f.t_s,
+            Self::WheelSpeed(w) => w.t_s,
         }
+    }
+
+    /// Whether `other` is of the same kind and time (a duplicate).
+    fn duplicates(&self, other: &Measurement) -> bool {
+        self.t_s() == other.t_s() && std::mem::discriminant(self) == std::mem::discriminant(other)
     }
 }
 
@@ -393,6 +405,36 @@ impl Engine {
         self.push_measurement(Measurement::Fix(fix))
     }
 
+    /// Feeds one forward speed of the base controller's wheels (m/s along the body x axis,
+    /// negative when reversing) with its 1-sigma (m/s; None: `wheel_odometry.sigma_mps`),
+    /// when `wheel_odometry.enabled` and the filter runs.
+    pub fn push_wheel_speed(
+        &mut self,
+        t_s: f64,
+        speed_mps: f64,
+        sigma_mps: Option<f64>,
+    ) -> Result<Vec<Output>, InputRejected> {
+        let reading = WheelSpeedReading {
+            t_s,
+            speed_mps,
+            sigma_mps,
+        };
+        if !reading.is_valid() {
+            return Err(self
+                .counters
+                .reject(RejectionReason::WheelSpeedInvalid, t_s));
+        }
+        if !self.config.wheel_odometry.enabled {
+            return Err(self.counters.reject(RejectionReason::WheelOdometryOff, t_s));
+        }
+        if self.state().is_none() {
+            return Err(self
+                .counters
+                .reject(RejectionReason::WheelSpeedBeforeStart, t_s));
+        }
+        self.push_measurement(Measurement::WheelSpeed(reading))
+    }
+
     fn push_measurement(&mut self, m: Measurement) -> Result<Vec<Output>, InputRejected> {
         let t = m.t_s();
         let Some(last_t) = self.last_imu_t_s() else {
@@ -400,11 +442,11 @@ impl Engine {
             self.enqueue(m, false);
             return Ok(Vec::new());
         };
-        if self.pending.iter().any(|p| p.measurement.t_s() == t)
+        if self.pending.iter().any(|p| p.measurement.duplicates(&m))
             || self
                 .history
                 .iter()
-                .any(|s| s.applied.iter().any(|a| a.t_s() == t))
+                .any(|s| s.applied.iter().any(|a| a.duplicates(&m)))
         {
             return Err(self
                 .counters
@@ -590,10 +632,21 @@ impl Engine {
                         let mut model = update::FixMeasurement::new(f, &w, &self.config, state);
                         update::apply(state, &mut model, adaptation, report)
                     }
+                    // Choice: the noise strategies and the process-noise scaling do not
+                    // learn from a wheel speed (as from the motion constraints): its σ is
+                    // the base controller's or the configured one, and the estimators stay
+                    // those of the GNSS measurements they were made for.
+                    Measurement::WheelSpeed(reading) => {
+                        let mut model = reading.model(&self.config);
+                        update::apply(state, &mut model, adaptation, false)
+                    }
                 };
+                let gnss = !matches!(p.measurement, Measurement::WheelSpeed(_));
                 match result {
                     Ok(epoch) if state.is_finite() => {
-                        if report {
+                        // A wheel speed is no GNSS input to monitor, and gives no report
+                        // (as the motion constraints).
+                        if report && gnss {
                             let reset = self.monitor_divergence(&before, &p.measurement, &epoch);
                             out.push(Output::Epoch(epoch));
                             out.extend(reset);

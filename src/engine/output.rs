@@ -192,6 +192,8 @@ pub enum MeasurementKind {
     ZeroRate,
     /// No lateral or vertical velocity of a wheeled vehicle (NHC).
     NonHolonomic,
+    /// The forward speed of a wheeled vehicle from its wheels (wheel odometry).
+    WheelSpeed,
     /// Time-differenced carrier phases: each satellite's phase change since the previous
     /// epoch (tightly coupled; its satellites' pseudo-range fields report the phase change,
     /// in m, and its rate fields are unused).

@@ -39,6 +39,13 @@ pub enum RejectionReason {
     WrongCoupling,
     /// The Kalman update failed (singular or non-finite); the state was kept.
     UpdateFailed,
+    /// A wheel speed whose time or speed is not finite, or whose given σ is not finite
+    /// and positive.
+    WheelSpeedInvalid,
+    /// A wheel speed while `wheel_odometry.enabled` is off.
+    WheelOdometryOff,
+    /// A wheel speed before the filter runs (start-up uses GNSS only).
+    WheelSpeedBeforeStart,
 }
 
 impl RejectionReason {
@@ -61,6 +68,9 @@ impl RejectionReason {
             Self::MeasurementQueueFull => "measurement_queue_full",
             Self::WrongCoupling => "wrong_coupling",
             Self::UpdateFailed => "update_failed",
+            Self::WheelSpeedInvalid => "wheel_speed_invalid",
+            Self::WheelOdometryOff => "wheel_odometry_off",
+            Self::WheelSpeedBeforeStart => "wheel_speed_before_start",
         }
     }
 }

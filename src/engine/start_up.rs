@@ -27,6 +27,7 @@ impl Engine {
         let started = match m {
             Measurement::Gnss(e) => init.try_gnss(e, &self.config, &recent),
             Measurement::Fix(f) => init.try_fix(f, &self.config, &recent),
+            Measurement::WheelSpeed(_) => None,
         };
         let Some(initial) = started else {
             return;
@@ -113,6 +114,10 @@ impl Engine {
                 Measurement::Fix(f) => {
                     let mut model = update::FixMeasurement::new(f, &w, config, state);
                     update::apply(state, &mut model, adaptation, true)
+                }
+                Measurement::WheelSpeed(reading) => {
+                    let mut model = reading.model(config);
+                    update::apply(state, &mut model, adaptation, false)
                 }
             }
         });

@@ -7,7 +7,8 @@
 use nalgebra::{Matrix3, Vector3};
 
 use super::msg::{
-    GnssMeasurements, Imu, NavSatFix, SatelliteMeasurement, Time, TwistWithCovarianceStamped,
+    GnssMeasurements, Imu, NavSatFix, Odometry, SatelliteMeasurement, Time,
+    TwistWithCovarianceStamped,
 };
 use crate::earth::Llh;
 use crate::engine::GnssFix;
@@ -92,6 +93,19 @@ pub enum ConvertError {
         /// Name of the field in `geometry_msgs/TwistWithCovariance`.
         field: &'static str,
     },
+    /// A wheel odometry whose forward speed is not finite, or whose variance of it is not
+    /// finite or negative.
+    #[error("wheel odometry at {t_s} s: {field} = {value}, expected {expected}")]
+    InvalidWheelOdometry {
+        /// Stamp of the odometry (s).
+        t_s: f64,
+        /// Name of the field in `nav_msgs/Odometry`.
+        field: &'static str,
+        /// The rejected value.
+        value: f64,
+        /// What is allowed.
+        expected: &'static str,
+    },
     /// A NavSatFix whose status says the receiver has no solution.
     #[error("NavSatFix at {t_s} s: status {status}, no solution")]
     NoFix {
@@ -175,6 +189,57 @@ impl TryFrom<&TwistWithCovarianceStamped> for GnssVelocity {
             frame_id: msg.header.frame_id.clone(),
             velocity_enu_mps: velocity,
             covariance_enu_m2_s2: (!unknown).then_some(block),
+        })
+    }
+}
+
+/// The base controller's forward speed (`wheel/odometry`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct WheelOdometrySpeed {
+    /// Stamp (s).
+    pub t_s: f64,
+    /// `child_frame_id`: the frame of the twist.
+    pub child_frame_id: String,
+    /// Forward speed (m/s).
+    pub speed_mps: f64,
+    /// Its 1-sigma (m/s); None when the message gives no variance.
+    pub sigma_mps: Option<f64>,
+}
+
+impl TryFrom<&Odometry> for WheelOdometrySpeed {
+    type Error = ConvertError;
+
+    /// Convention (REP-105, nav_msgs/Odometry): the twist is in `child_frame_id`, the
+    /// vehicle's base frame (x forward); `twist.twist.linear.x` is the forward speed and
+    /// `twist.covariance[0]` its variance; the rest is ignored. Choice: a variance of 0
+    /// is none (ros2_controllers' diff_drive_controller sends 0 unless configured), and
+    /// the configured σ applies; nav_msgs has no "unknown" marker (sensor_msgs' −1), so
+    /// a negative variance is a broken message.
+    fn try_from(msg: &Odometry) -> Result<Self, Self::Error> {
+        let t_s = time_to_seconds(&msg.header.stamp)?;
+        let speed_mps = msg.twist.twist.linear.x;
+        if !speed_mps.is_finite() {
+            return Err(ConvertError::InvalidWheelOdometry {
+                t_s,
+                field: "twist.twist.linear.x",
+                value: speed_mps,
+                expected: "finite",
+            });
+        }
+        let variance = msg.twist.covariance[0];
+        if !(variance.is_finite() && variance >= 0.0) {
+            return Err(ConvertError::InvalidWheelOdometry {
+                t_s,
+                field: "twist.covariance[0]",
+                value: variance,
+                expected: "finite and not negative",
+            });
+        }
+        Ok(Self {
+            t_s,
+            child_frame_id: msg.child_frame_id.clone(),
+            speed_mps,
+            sigma_mps: (variance > 0.0).then(|| variance.sqrt()),
         })
     }
 }
@@ -946,6 +1011,50 @@ mod tests {
                 ..
             })
         ));
+    }
+
+    #[test]
+    fn wheel_speed_is_the_forward_twist_of_the_odometry() {
+        let mut msg = Odometry::default();
+        msg.header.stamp = Time {
+            sec: 3,
+            nanosec: 500_000_000,
+        };
+        msg.header.frame_id = "odom".to_owned();
+        msg.child_frame_id = "base_link".to_owned();
+        msg.twist.twist.linear.x = -1.25;
+        msg.twist.twist.linear.y = 4.0; // lateral: ignored
+        let w = WheelOdometrySpeed::try_from(&msg).unwrap();
+        assert_eq!(
+            w,
+            WheelOdometrySpeed {
+                t_s: 3.5,
+                child_frame_id: "base_link".to_owned(),
+                speed_mps: -1.25,
+                sigma_mps: None,
+            }
+        );
+        msg.twist.covariance[0] = 0.0004;
+        msg.twist.covariance[7] = 9.0; // lateral: ignored
+        let sigma = WheelOdometrySpeed::try_from(&msg).unwrap().sigma_mps;
+        assert_eq!(sigma, Some(0.02));
+        for (variance, speed) in [
+            (-1.0, 1.0),
+            (f64::NAN, 1.0),
+            (f64::INFINITY, 1.0),
+            (0.0004, f64::NAN),
+            (0.0004, f64::NEG_INFINITY),
+        ] {
+            msg.twist.covariance[0] = variance;
+            msg.twist.twist.linear.x = speed;
+            assert!(
+                matches!(
+                    WheelOdometrySpeed::try_from(&msg),
+                    Err(ConvertError::InvalidWheelOdometry { t_s, .. }) if t_s == 3.5
+                ),
+                "variance {variance}, speed {speed}"
+            );
+        }
     }
 
     #[test]

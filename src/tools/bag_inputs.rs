@@ -19,6 +19,10 @@ use crate::ros::msg::{
 
 use super::scoring::Reference;
 
+/// The node's wheel odometry topic (`wheel/odometry` in the root namespace): the simulator
+/// writes none.
+pub const WHEEL_ODOMETRY_TOPIC: &str = "/wheel/odometry";
+
 /// Which topic carries what.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct BagTopics {
@@ -28,6 +32,9 @@ pub struct BagTopics {
     /// geometry_msgs/TwistWithCovarianceStamped receiver velocities, joined with the fix of
     /// their stamp.
     pub velocity: String,
+    /// nav_msgs/Odometry of the base controller, whose forward speed is fed with
+    /// `wheel_odometry.enabled`.
+    pub wheel_odometry: String,
     /// nav_msgs/Odometry reference in an ENU frame at `truth_datum` (None: no reference).
     pub truth: Option<String>,
     pub truth_datum: String,
@@ -43,6 +50,7 @@ impl Default for BagTopics {
             gnss: GNSS_TOPIC.to_owned(),
             fix: FIX_TOPIC.to_owned(),
             velocity: VELOCITY_TOPIC.to_owned(),
+            wheel_odometry: WHEEL_ODOMETRY_TOPIC.to_owned(),
             truth: Some(TRUTH_TOPIC.to_owned()),
             truth_datum: TRUTH_DATUM_TOPIC.to_owned(),
             truth_noise: TRUTH_NOISE_TOPIC.to_owned(),
@@ -68,7 +76,7 @@ impl Role {
             Role::Input(Input::Gnss) => GnssMeasurements::TYPE_NAME,
             Role::Input(Input::Fix) | Role::TruthDatum => NavSatFix::TYPE_NAME,
             Role::Input(Input::Velocity) => TwistWithCovarianceStamped::TYPE_NAME,
-            Role::Truth => Odometry::TYPE_NAME,
+            Role::Input(Input::WheelOdometry) | Role::Truth => Odometry::TYPE_NAME,
             Role::TruthNoise => NoiseEstimates::TYPE_NAME,
             Role::Environment => DiagnosticArray::TYPE_NAME,
         }
@@ -86,6 +94,8 @@ impl BagTopics {
             Some(Role::Input(Input::Fix))
         } else if topic == self.velocity {
             Some(Role::Input(Input::Velocity))
+        } else if topic == self.wheel_odometry {
+            Some(Role::Input(Input::WheelOdometry))
         } else if topic == self.truth_datum {
             Some(Role::TruthDatum)
         } else if self.truth.as_deref() == Some(topic) {
@@ -242,6 +252,9 @@ impl BagInputs {
             Role::Input(Input::Gnss) => InputMessage::Gnss(decode(data)?),
             Role::Input(Input::Fix) => InputMessage::Fix(decode(data)?),
             Role::Input(Input::Velocity) => InputMessage::Velocity(decode(data)?),
+            Role::Input(Input::WheelOdometry) => {
+                InputMessage::WheelOdometry(Box::new(decode(data)?))
+            }
             Role::TruthDatum => {
                 let msg: NavSatFix = decode(data)?;
                 self.datum = Some(Llh::from_degrees(msg.latitude, msg.longitude, msg.altitude));

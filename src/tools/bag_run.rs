@@ -15,17 +15,22 @@ use crate::ros::bag::{BagError, BagReader};
 use super::bag_inputs::{BagInput, BagInputs, BagTopics, ReadProblems};
 use super::scoring::{Scorer, SessionReport};
 
-/// The input streams a run feeds: the IMU and the measurements of the configured coupling.
+/// The input streams a run of `config` feeds: the IMU, the measurements of the
+/// configured coupling and, with `wheel_odometry.enabled`, the wheel odometry.
 ///
 /// Choice: the node receives the other coupling's measurements too, and its engine
 /// rejects each as `wrong_coupling` without any other effect; a bag carries both (the
 /// simulator writes both), so a run counts them once as unfed instead of logging a
-/// rejection for each.
-fn fed_inputs(coupling: Coupling) -> &'static [Input] {
-    match coupling {
-        Coupling::Tight => &[Input::Imu, Input::Gnss],
-        Coupling::Loose => &[Input::Imu, Input::Fix, Input::Velocity],
+/// rejection for each. The same for a wheel odometry the configuration does not use.
+fn fed_inputs(config: &Config) -> Vec<Input> {
+    let mut fed = match config.filter.coupling {
+        Coupling::Tight => vec![Input::Imu, Input::Gnss],
+        Coupling::Loose => vec![Input::Imu, Input::Fix, Input::Velocity],
+    };
+    if config.wheel_odometry.enabled {
+        fed.push(Input::WheelOdometry);
     }
+    fed
 }
 
 /// What became of a run's inputs.
@@ -118,9 +123,9 @@ impl BagRunner {
         adapter: RosAdapter,
         scorer: Scorer,
     ) -> Result<Self, BagError> {
-        let fed = fed_inputs(adapter.engine().config().filter.coupling);
+        let fed = fed_inputs(adapter.engine().config());
         Ok(Self {
-            inputs: BagInputs::new(reader.messages()?, topics, fed),
+            inputs: BagInputs::new(reader.messages()?, topics, &fed),
             adapter,
             scorer,
             total_messages: reader.topics().iter().map(|t| t.message_count).sum(),

@@ -16,6 +16,12 @@ pub enum SessionInput {
     Imu(ImuSample),
     Gnss(GnssEpoch),
     Fix(GnssFix),
+    /// A forward speed of the wheels (m/s) with its 1-sigma (m/s; None: the configured).
+    WheelSpeed {
+        t_s: f64,
+        speed_mps: f64,
+        sigma_mps: Option<f64>,
+    },
     Reference(Reference),
 }
 
@@ -48,6 +54,11 @@ impl Session {
             SessionInput::Gnss(e) if coupling == Coupling::Tight => self.engine.push_gnss(e),
             SessionInput::Fix(f) if coupling == Coupling::Loose => self.engine.push_fix(f),
             SessionInput::Gnss(_) | SessionInput::Fix(_) => return Vec::new(),
+            SessionInput::WheelSpeed {
+                t_s,
+                speed_mps,
+                sigma_mps,
+            } => self.engine.push_wheel_speed(t_s, speed_mps, sigma_mps),
             SessionInput::Reference(r) => {
                 self.scorer.on_reference(r);
                 return Vec::new();

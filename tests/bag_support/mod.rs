@@ -6,9 +6,11 @@ use std::path::Path;
 use adaptive_gnss_ins::ros::bag::{BagError, BagWriteOptions, BagWriter};
 use adaptive_gnss_ins::ros::cdr;
 use adaptive_gnss_ins::ros::msg::{
-    GnssMeasurements, Header, Imu, NavSatFix, NavSatStatus, NoiseEstimates, Odometry, Quaternion,
-    RosMessage, SatelliteMeasurement, SatelliteNoise, Time, Vector3,
+    DiagnosticArray, GnssMeasurements, Header, Imu, NavSatFix, NavSatStatus, NoiseEstimates,
+    Odometry, Quaternion, RosMessage, SatelliteMeasurement, SatelliteNoise, Time,
+    TwistWithCovarianceStamped, Vector3,
 };
+use adaptive_gnss_ins::tools::simulate;
 
 /// Log time of the first message: 2023-11-14T22:13:20Z, in ns.
 pub const START_NS: u64 = 1_700_000_000_000_000_000;
@@ -240,4 +242,27 @@ pub fn write_sample_bag(path: &Path, options: BagWriteOptions, seconds: u64) -> 
         }
     }
     recorder.finish().unwrap()
+}
+
+/// Adds the topics `gnss_ins simulate` writes (with `--velocity`) to `writer`, for a copy
+/// of a simulated bag.
+pub fn add_simulated_topics(writer: &mut BagWriter) {
+    writer.add_topic::<Imu>(simulate::IMU_TOPIC).unwrap();
+    writer
+        .add_topic::<GnssMeasurements>(simulate::GNSS_TOPIC)
+        .unwrap();
+    writer.add_topic::<NavSatFix>(simulate::FIX_TOPIC).unwrap();
+    writer
+        .add_topic::<TwistWithCovarianceStamped>(simulate::VELOCITY_TOPIC)
+        .unwrap();
+    writer.add_topic::<Odometry>(simulate::TRUTH_TOPIC).unwrap();
+    writer
+        .add_topic::<NavSatFix>(simulate::TRUTH_DATUM_TOPIC)
+        .unwrap();
+    writer
+        .add_topic::<NoiseEstimates>(simulate::TRUTH_NOISE_TOPIC)
+        .unwrap();
+    writer
+        .add_topic::<DiagnosticArray>(simulate::TRUTH_ENVIRONMENT_TOPIC)
+        .unwrap();
 }

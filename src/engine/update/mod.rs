@@ -20,9 +20,9 @@
 //! previous epoch; [`apply_gnss_epoch`] runs both), [`FixMeasurement`] (loosely coupled: a
 //! receiver's position and velocity fix), and the constraints of the vehicle's motion
 //! (`super::constraints`): [`ZeroVelocity`], [`ZeroRate`] at a standstill and
-//! [`NonHolonomic`] for a wheeled vehicle.
+//! [`NonHolonomic`] for a wheeled vehicle; [`WheelSpeed`] (wheel odometry, optional).
 //!
-//! Adding a model (wheel speed, a dual-antenna heading, ...): a file here with a type that
+//! Adding a model (a dual-antenna heading, ...): a file here with a type that
 //! borrows the measurement and the configuration and implements [`MeasurementModel`]; its `linearize` returns the rows of H
 //! (new rows belong in [`crate::filter::measurement_rows`]), the measured and predicted
 //! values and the nominal noise — [`NominalNoise::Joint`] for a vector measurement (the
@@ -38,9 +38,11 @@ mod fix;
 mod gate;
 mod model;
 mod non_holonomic;
+mod point_velocity;
 mod pseudoranges;
 #[cfg(test)]
 mod tests;
+mod wheel_speed;
 mod zero_rate;
 mod zero_velocity;
 
@@ -69,6 +71,7 @@ pub use fix::{FixMeasurement, GnssFix};
 pub use model::{Linearization, MeasurementModel, NoiseChannel, NominalNoise};
 pub use non_holonomic::NonHolonomic;
 pub use pseudoranges::{sigma_model, Pseudoranges};
+pub use wheel_speed::WheelSpeed;
 pub use zero_rate::ZeroRate;
 pub use zero_velocity::ZeroVelocity;
 

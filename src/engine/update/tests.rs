@@ -13,7 +13,9 @@ use crate::ins::{ImuSample, NavState};
 use super::super::adaptation::Adaptation;
 use super::super::filter_state::FilterState;
 use super::super::output::{EpochReport, MeasurementKind};
-use super::{apply, Linearization, MeasurementModel, NonHolonomic, ZeroRate, ZeroVelocity};
+use super::{
+    apply, Linearization, MeasurementModel, NonHolonomic, WheelSpeed, ZeroRate, ZeroVelocity,
+};
 
 /// The zero-velocity model, reporting the robust weights in the fix's field.
 struct Reported(ZeroVelocity);
@@ -155,6 +157,12 @@ fn constraint_rows_match_differences() {
         lever_arm_b_m: &lever,
         sigma_lateral_mps: 0.1,
         sigma_vertical_mps: 0.1,
+    });
+    check_rows(WheelSpeed {
+        t_s: 0.0,
+        lever_arm_b_m: &lever,
+        speed_mps: 12.0,
+        sigma_mps: 0.05,
     });
 }
 

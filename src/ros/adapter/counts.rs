@@ -11,6 +11,8 @@ pub enum Input {
     Fix,
     /// `gnss/velocity`: geometry_msgs/TwistWithCovarianceStamped (with the fix).
     Velocity,
+    /// `wheel/odometry`: nav_msgs/Odometry of the base controller (its forward speed).
+    WheelOdometry,
 }
 
 impl Input {
@@ -21,6 +23,7 @@ impl Input {
             Input::Gnss => "gnss/measurements",
             Input::Fix => "gnss/fix",
             Input::Velocity => "gnss/velocity",
+            Input::WheelOdometry => "wheel/odometry",
         }
     }
 }
@@ -37,6 +40,8 @@ pub struct InputCounts {
     pub fix_received: u64,
     /// TwistWithCovarianceStamped messages decoded on `gnss/velocity`.
     pub velocity_received: u64,
+    /// nav_msgs/Odometry messages decoded on `wheel/odometry`.
+    pub wheel_odometry_received: u64,
     /// Velocities fed to the engine with their fix.
     pub velocity_paired: u64,
     /// Payloads that did not decode, any topic.
@@ -49,6 +54,9 @@ pub struct InputCounts {
     pub unconvertible_fix: u64,
     /// Velocities with a bad stamp or a non-finite value.
     pub unconvertible_velocity: u64,
+    /// Wheel odometries with a bad stamp, a non-finite forward speed or a variance of it
+    /// that is not finite or negative.
+    pub unconvertible_wheel_odometry: u64,
     /// Resets because the IMU time jumped backwards (several consecutive samples agreed).
     pub time_jump_resets: u64,
     /// IMU samples whose stamp was far off the time line and that no run of consecutive
@@ -66,6 +74,8 @@ pub struct InputCounts {
     pub foreign_frame_fix: u64,
     /// Velocities neither in the map frame nor in their fix's frame (fix used without).
     pub foreign_frame_velocity: u64,
+    /// Wheel odometries whose `child_frame_id` is another than the locked one.
+    pub foreign_frame_wheel_odometry: u64,
     /// Times the IMU stream's learnt frame moved to another one (the locked frame went
     /// silent; the filter reset).
     pub frame_switches_imu: u64,
@@ -73,6 +83,8 @@ pub struct InputCounts {
     pub frame_switches_gnss: u64,
     /// Times the NavSatFix stream's learnt frame moved to another one.
     pub frame_switches_fix: u64,
+    /// Times the wheel odometry's learnt `child_frame_id` moved to another one.
+    pub frame_switches_wheel_odometry: u64,
 }
 
 impl InputCounts {
@@ -83,6 +95,7 @@ impl InputCounts {
             Input::Gnss => &mut self.unconvertible_gnss,
             Input::Fix => &mut self.unconvertible_fix,
             Input::Velocity => &mut self.unconvertible_velocity,
+            Input::WheelOdometry => &mut self.unconvertible_wheel_odometry,
         }
     }
 
@@ -93,6 +106,7 @@ impl InputCounts {
             Input::Gnss => &mut self.foreign_frame_gnss,
             Input::Fix => &mut self.foreign_frame_fix,
             Input::Velocity => &mut self.foreign_frame_velocity,
+            Input::WheelOdometry => &mut self.foreign_frame_wheel_odometry,
         }
     }
 
@@ -102,6 +116,7 @@ impl InputCounts {
             Input::Imu => &mut self.frame_switches_imu,
             Input::Gnss => &mut self.frame_switches_gnss,
             Input::Fix | Input::Velocity => &mut self.frame_switches_fix,
+            Input::WheelOdometry => &mut self.frame_switches_wheel_odometry,
         }
     }
 
@@ -109,33 +124,46 @@ impl InputCounts {
     /// stamp outliers, the ones that did not convert and the ones from a foreign frame (a
     /// velocity in a foreign frame drops no message: its fix goes on alone), named as on
     /// /diagnostics.
-    pub fn dropped(&self) -> [(&'static str, u64); 8] {
+    pub fn dropped(&self) -> [(&'static str, u64); 10] {
         [
             ("imu_stamp_outliers", self.imu_stamp_outliers),
             ("unconvertible_imu", self.unconvertible_imu),
             ("unconvertible_gnss", self.unconvertible_gnss),
             ("unconvertible_fix", self.unconvertible_fix),
             ("unconvertible_velocity", self.unconvertible_velocity),
+            (
+                "unconvertible_wheel_odometry",
+                self.unconvertible_wheel_odometry,
+            ),
             ("foreign_frame_imu", self.foreign_frame_imu),
             ("foreign_frame_gnss", self.foreign_frame_gnss),
             ("foreign_frame_fix", self.foreign_frame_fix),
+            (
+                "foreign_frame_wheel_odometry",
+                self.foreign_frame_wheel_odometry,
+            ),
         ]
     }
 
     /// The counters as (name, value) in the order of the /diagnostics report; the names
     /// are the report's keys.
-    pub fn named(&self) -> [(&'static str, u64); 21] {
+    pub fn named(&self) -> [(&'static str, u64); 25] {
         [
             ("imu_received", self.imu_received),
             ("gnss_received", self.gnss_received),
             ("fix_received", self.fix_received),
             ("velocity_received", self.velocity_received),
+            ("wheel_odometry_received", self.wheel_odometry_received),
             ("velocity_paired", self.velocity_paired),
             ("undecodable", self.undecodable),
             ("unconvertible_imu", self.unconvertible_imu),
             ("unconvertible_gnss", self.unconvertible_gnss),
             ("unconvertible_fix", self.unconvertible_fix),
             ("unconvertible_velocity", self.unconvertible_velocity),
+            (
+                "unconvertible_wheel_odometry",
+                self.unconvertible_wheel_odometry,
+            ),
             ("time_jump_resets", self.time_jump_resets),
             ("imu_stamp_outliers", self.imu_stamp_outliers),
             ("non_finite_outputs", self.non_finite_outputs),
@@ -144,9 +172,17 @@ impl InputCounts {
             ("foreign_frame_gnss", self.foreign_frame_gnss),
             ("foreign_frame_fix", self.foreign_frame_fix),
             ("foreign_frame_velocity", self.foreign_frame_velocity),
+            (
+                "foreign_frame_wheel_odometry",
+                self.foreign_frame_wheel_odometry,
+            ),
             ("frame_switches_imu", self.frame_switches_imu),
             ("frame_switches_gnss", self.frame_switches_gnss),
             ("frame_switches_fix", self.frame_switches_fix),
+            (
+                "frame_switches_wheel_odometry",
+                self.frame_switches_wheel_odometry,
+            ),
         ]
     }
 }

@@ -4,10 +4,10 @@
 use crate::engine::{GnssFix, Output, ResetReason};
 use crate::gnss::GnssEpoch;
 use crate::ins::ImuSample;
-use crate::ros::convert::GnssVelocity;
+use crate::ros::convert::{GnssVelocity, WheelOdometrySpeed};
 use crate::ros::fix_velocity::{FramedFix, Joined, VelocityUse};
 use crate::ros::msg::{
-    GnssMeasurements, Imu, NavSatFix, TFMessage, Time, TwistWithCovarianceStamped,
+    GnssMeasurements, Imu, NavSatFix, Odometry, TFMessage, Time, TwistWithCovarianceStamped,
 };
 
 use super::frame_lock::Admission;
@@ -21,6 +21,7 @@ pub enum InputMessage {
     Gnss(GnssMeasurements),
     Fix(NavSatFix),
     Velocity(TwistWithCovarianceStamped),
+    WheelOdometry(Box<Odometry>),
 }
 
 impl RosAdapter {
@@ -31,6 +32,7 @@ impl RosAdapter {
             InputMessage::Gnss(m) => self.on_gnss(m),
             InputMessage::Fix(m) => self.on_fix(m),
             InputMessage::Velocity(m) => self.on_velocity(m),
+            InputMessage::WheelOdometry(m) => self.on_wheel_odometry(m),
         }
     }
 
@@ -193,6 +195,39 @@ impl RosAdapter {
         self.publish_fixes(released)
     }
 
+    /// Handles one nav_msgs/Odometry of the base controller on `wheel/odometry`: its
+    /// forward speed ([`WheelOdometrySpeed`]) goes to the engine, which rejects and counts
+    /// it unless `wheel_odometry.enabled`. The stream is locked to one `child_frame_id`,
+    /// the frame of the twist.
+    pub fn on_wheel_odometry(&mut self, msg: &Odometry) -> Vec<Published> {
+        self.counts.wheel_odometry_received += 1;
+        let speed = match WheelOdometrySpeed::try_from(msg) {
+            Ok(s) => s,
+            Err(e) => return self.unconvertible(Input::WheelOdometry, &e.to_string()),
+        };
+        let frame_id = &speed.child_frame_id;
+        match self.wheel_frame.admit(frame_id) {
+            Admission::Admitted => {}
+            Admission::Foreign => return self.foreign_frame(Input::WheelOdometry, frame_id),
+            Admission::Switched => self.frame_switched(Input::WheelOdometry, frame_id),
+        }
+        let pushed = self
+            .engine
+            .push_wheel_speed(speed.t_s, speed.speed_mps, speed.sigma_mps);
+        let outputs = match pushed {
+            Ok(o) => {
+                self.wheel_frame.accepted(frame_id);
+                o
+            }
+            Err(e) => {
+                self.log
+                    .warn(e.reason.name(), &format!("wheel odometry: {e}"));
+                Vec::new()
+            }
+        };
+        self.publishable(outputs)
+    }
+
     /// Feeds joined fixes; what the engine returned, to publish.
     fn publish_fixes(&mut self, joined: Vec<Joined>) -> Vec<Published> {
         let mut outputs = Vec::new();
@@ -248,6 +283,7 @@ impl RosAdapter {
                 "`{}` (ENU) or its fix's frame",
                 self.outputs.frames().map_frame
             ),
+            Input::WheelOdometry => format!("child frame `{}`", self.wheel_frame.locked()),
         };
         *self.counts.foreign_frame(input) += 1;
         let name = input.name();

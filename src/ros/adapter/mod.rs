@@ -64,6 +64,8 @@ pub struct RosAdapter {
     time_line: TimeLine,
     gnss_frame: FrameLock,
     fix_frame: FrameLock,
+    /// The wheel odometry's `child_frame_id`.
+    wheel_frame: FrameLock,
     pairing: FixVelocityJoin,
     outputs: outputs::Framing,
     /// The stamps of the IMU samples, which solutions carry.
@@ -87,6 +89,7 @@ impl RosAdapter {
             time_line: TimeLine::default(),
             gnss_frame: FrameLock::default(),
             fix_frame: FrameLock::default(),
+            wheel_frame: FrameLock::default(),
             imu_stamps: StampBook::default(),
             measurement_stamps: StampBook::default(),
             phases: PhaseCounts::default(),

@@ -151,10 +151,12 @@ impl Framing {
                     .map(|s| s.sat.constellation),
             ),
             MeasurementKind::Fix => self.fix_service,
-            // The engine reports no epochs of its motion constraints: they use no signal.
+            // The engine reports no epochs of its motion constraints or of the wheel
+            // speed: they use no signal.
             MeasurementKind::ZeroVelocity
             | MeasurementKind::ZeroRate
-            | MeasurementKind::NonHolonomic => return,
+            | MeasurementKind::NonHolonomic
+            | MeasurementKind::WheelSpeed => return,
             // Choice: the phases' report rides inside its epoch's pseudo-range report,
             // which names the service; on its own it changes nothing.
             MeasurementKind::CarrierPhaseDeltas => return,

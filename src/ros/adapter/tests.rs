@@ -848,3 +848,64 @@ fn carrier_phase_changes_used_and_left_out_are_counted_on_diagnostics() {
     let (adapter, _) = run(false);
     assert_eq!(diagnostic(&adapter, "tdcp_phases_used"), None);
 }
+
+/// Issue 14, item 3: wheel odometry on /diagnostics. With `wheel_odometry.enabled`, the
+/// static scenario's standstill is reported by a base controller at the truth's rate:
+/// every message is counted as received; one with a NaN speed or a negative variance as
+/// unconvertible, one from a second child frame as foreign; the speeds before the filter
+/// runs are rejected as such, the others reach the filter.
+#[test]
+fn wheel_odometry_is_counted_on_diagnostics() {
+    use crate::ros::msg::Odometry;
+    use crate::sim::SimEvent;
+    let mut config = loose_adapter(OutputFrames::default())
+        .engine()
+        .config()
+        .clone();
+    config
+        .set_parameter("wheel_odometry.enabled", "true")
+        .unwrap();
+    let mut adapter = RosAdapter::new(config, OutputFrames::default());
+    let odometry = |stamp: Time, child_frame_id: &str, speed_mps: f64, variance: f64| {
+        let mut msg = Odometry::default();
+        msg.header.stamp = stamp;
+        msg.header.frame_id = "odom".to_owned();
+        msg.child_frame_id = child_frame_id.to_owned();
+        msg.twist.twist.linear.x = speed_mps;
+        msg.twist.covariance[0] = variance;
+        msg
+    };
+    let mut sent = 0;
+    for_each_static_event_30_s(|event, stamp| match event {
+        SimEvent::Imu(s) => {
+            adapter.on_imu(&outbound::imu(&s, stamp, "imu"));
+        }
+        SimEvent::Fix(f) => {
+            adapter.on_fix(&outbound::receiver_fix(&f, stamp, "gnss"));
+        }
+        SimEvent::Truth(_) => {
+            adapter.on_wheel_odometry(&odometry(stamp, "base_link", 0.0, 1e-4));
+            sent += 1;
+        }
+        _ => {}
+    });
+    let late = seconds_to_time(29.995).unwrap();
+    for msg in [
+        odometry(late, "base_link", f64::NAN, 1e-4),
+        odometry(late, "base_link", 0.0, -1e-4),
+        odometry(late, "wheels_of_another_robot", 0.0, 1e-4),
+    ] {
+        adapter.on_message(&InputMessage::WheelOdometry(Box::new(msg)));
+    }
+    assert_eq!(adapter.engine().init_phase(), None, "running");
+    let count = |key: &str| diagnostic(&adapter, key).unwrap().parse::<u64>().unwrap();
+    assert!(sent > 200, "{sent}");
+    assert_eq!(count("wheel_odometry_received"), sent + 3);
+    assert_eq!(count("unconvertible_wheel_odometry"), 2);
+    assert_eq!(count("foreign_frame_wheel_odometry"), 1);
+    let before_start = count("rejected_wheel_speed_before_start");
+    assert!(before_start > 0 && before_start < sent, "{before_start}");
+    let counters = adapter.engine().counters();
+    assert_eq!(counters.count(RejectionReason::WheelSpeedInvalid), 0);
+    assert_eq!(counters.count(RejectionReason::WheelOdometryOff), 0);
+}

@@ -13,6 +13,8 @@ pub enum Stream {
     Fix,
     /// `gnss/velocity`.
     Velocity,
+    /// `wheel/odometry` (subscribed with `wheel_odometry.enabled`).
+    WheelOdometry,
 }
 
 impl Stream {
@@ -39,7 +41,7 @@ pub const IMU_STALE_S: f64 = 1.0;
 
 /// `gnss_ins_node`'s streams; the IMU is watched.
 pub const FILTER_NODE_STREAMS: StreamSet = StreamSet {
-    keys: &["imu", "gnss", "fix", "velocity"],
+    keys: &["imu", "gnss", "fix", "velocity", "wheel_odometry"],
     watched: &[(0, IMU_STALE_S)],
 };
 

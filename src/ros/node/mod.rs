@@ -3,12 +3,14 @@
 //!
 //! Topics (relative, so `__ns` and remappings apply): subscribes `imu`
 //! (sensor_msgs/Imu), `gnss/measurements` (GnssMeasurements), `gnss/fix` (NavSatFix),
-//! `gnss/velocity` (TwistWithCovarianceStamped), `/clock` (rosgraph_msgs/Clock, for
-//! `use_sim_time`); publishes `odometry` (nav_msgs/Odometry, `map_frame` → `base_frame`),
-//! `fix/filtered` (NavSatFix), `~/noise_estimates` (NoiseEstimates), `/diagnostics`
-//! (DiagnosticArray, 1 Hz), `/rosout` (rcl_interfaces/Log), `/parameter_events`
-//! (rcl_interfaces/ParameterEvent: each parameter declared at the start, then each
-//! accepted set, as rclcpp announces them) and, with `publish_tf`, `/tf`
+//! `gnss/velocity` (TwistWithCovarianceStamped), with `wheel_odometry.enabled`
+//! `wheel/odometry` (nav_msgs/Odometry of the base controller), `/clock`
+//! (rosgraph_msgs/Clock, for `use_sim_time`); publishes `odometry` (nav_msgs/Odometry,
+//! `map_frame` → `base_frame`), `fix/filtered` (NavSatFix), `~/noise_estimates`
+//! (NoiseEstimates), `/diagnostics` (DiagnosticArray, 1 Hz), `/rosout`
+//! (rcl_interfaces/Log), `/parameter_events` (rcl_interfaces/ParameterEvent: each
+//! parameter declared at the start, then each accepted set, as rclcpp announces them)
+//! and, with `publish_tf`, `/tf`
 //! (tf2_msgs/TFMessage: `map_frame → base_frame`, or in `tf_mode` `map_to_odom`
 //! `map_frame → odom_frame`, for which it also subscribes `/tf` to hear the base
 //! controller's `odom_frame → base_frame`). Serves the parameter services ([`services`]).
@@ -50,6 +52,7 @@ enum Event {
     Gnss(Result<GnssMeasurements, String>),
     Fix(Result<NavSatFix, String>),
     Velocity(Result<TwistWithCovarianceStamped, String>),
+    WheelOdometry(Result<Box<Odometry>, String>),
     Clock(Result<Clock, String>),
     Tf(Result<TFMessage, String>),
     Param(ParamRequest),
@@ -120,6 +123,15 @@ pub fn run(
     let fix_sub = subscription::<NavSatFix>(&mut node, &names, "gnss/fix")?;
     let velocity_sub =
         subscription::<TwistWithCovarianceStamped>(&mut node, &names, "gnss/velocity")?;
+    let wheel_sub = if params.config.wheel_odometry.enabled {
+        Some(subscription::<Odometry>(
+            &mut node,
+            &names,
+            "wheel/odometry",
+        )?)
+    } else {
+        None
+    };
     let clock_sub = subscription::<Clock>(&mut node, &names, "/clock")?;
     let tf_sub = if params.frames.published_tf() == TfMode::MapToOdom {
         Some(subscription::<TFMessage>(&mut node, &names, "/tf")?)
@@ -172,6 +184,11 @@ pub fn run(
         events(&velocity_sub, Event::Velocity),
         events(&clock_sub, Event::Clock),
     ];
+    sources.extend(
+        wheel_sub
+            .as_ref()
+            .map(|sub| events(sub, |m| Event::WheelOdometry(m.map(Box::new)))),
+    );
     sources.extend(tf_sub.as_ref().map(|sub| events(sub, Event::Tf)));
     sources.extend(housekeeping::housekeeping(
         &services,
@@ -225,6 +242,13 @@ pub fn run(
                     match m {
                         Ok(m) => core.on_velocity(&m),
                         Err(e) => undecodable(&mut core, "gnss/velocity", &e),
+                    }
+                }
+                Event::WheelOdometry(m) => {
+                    stats.record(Stream::WheelOdometry.index(), now_s());
+                    match m {
+                        Ok(m) => core.on_wheel_odometry(&m),
+                        Err(e) => undecodable(&mut core, "wheel/odometry", &e),
                     }
                 }
                 Event::Clock(Ok(m)) => {
