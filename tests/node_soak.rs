@@ -26,7 +26,7 @@ use adaptive_gnss_ins::ros::msg::{DiagnosticArray, Imu, Time};
 use adaptive_gnss_ins::ros::outbound;
 use adaptive_gnss_ins::sim::{Scenario, ScenarioSpec, Segment, SimEvent};
 use nalgebra::Vector3;
-use netns_support::reexec_in_private_netns;
+use netns_support::{reexec_in_private_netns, rss_kb};
 use ros2_client::Name;
 use static_node_support::{diagnostic_count, start_node, type_name, Peer};
 
@@ -88,16 +88,6 @@ impl Heard {
         }
         while let Ok(Some(_)) = peer.tf.take() {}
     }
-}
-
-/// Resident memory (kB) of process `pid`.
-fn rss_kb(pid: u32) -> u64 {
-    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap();
-    status
-        .lines()
-        .find_map(|l| l.strip_prefix("VmRSS:"))
-        .and_then(|v| v.trim().trim_end_matches(" kB").trim().parse().ok())
-        .unwrap()
 }
 
 fn stamp(t_s: f64) -> Time {
