@@ -125,23 +125,7 @@ impl Peer {
         assert!(matched, "the node's topics were not discovered within 20 s");
         peer
     }
-}
 
-/// The value of `key` in the node's /diagnostics report `d`.
-pub fn diagnostic_value(d: &DiagnosticArray, key: &str) -> Option<String> {
-    d.status[0]
-        .values
-        .iter()
-        .find(|kv| kv.key == key)
-        .map(|kv| kv.value.clone())
-}
-
-/// The counter `key` of the node's /diagnostics report `d`.
-pub fn diagnostic_count(d: &DiagnosticArray, key: &str) -> Option<u64> {
-    diagnostic_value(d, key).and_then(|v| v.parse().ok())
-}
-
-impl Peer {
     /// Our side having matched does not mean the node's readers have matched our writers
     /// yet (best effort drops what it sends before): sends an IMU sample with a NaN
     /// (dropped as unconvertible) and an empty GNSS epoch (rejected for having no
@@ -175,4 +159,18 @@ impl Peer {
         }
         (bad_counted, empty_counted)
     }
+}
+
+/// The value of `key` in the node's /diagnostics report `d`.
+pub fn diagnostic_value(d: &DiagnosticArray, key: &str) -> Option<String> {
+    d.status[0]
+        .values
+        .iter()
+        .find(|kv| kv.key == key)
+        .map(|kv| kv.value.clone())
+}
+
+/// The counter `key` of the node's /diagnostics report `d`.
+pub fn diagnostic_count(d: &DiagnosticArray, key: &str) -> Option<u64> {
+    diagnostic_value(d, key).and_then(|v| v.parse().ok())
 }
