@@ -14,11 +14,10 @@ use std::time::{Duration, Instant};
 
 use adaptive_gnss_ins::earth::{self, Llh};
 use adaptive_gnss_ins::ros::convert::seconds_to_time;
-use adaptive_gnss_ins::ros::msg::{DiagnosticArray, GnssMeasurements, Imu};
 use adaptive_gnss_ins::ros::outbound;
 use adaptive_gnss_ins::sim::SimEvent;
 use netns_support::reexec_in_private_netns;
-use static_node_support::{start_node, static_scenario, Peer};
+use static_node_support::{diagnostic_value, start_node, static_scenario, Peer};
 
 const DOMAIN_ID: u16 = 17;
 /// Position budget of the ekf preset on a static receiver after a minute of 1 Hz GNSS,
@@ -48,6 +47,10 @@ fn node_estimates_a_static_receiver() {
             "base_frame:=imu_link",
         ],
     );
+    let peer = Peer::matched(DOMAIN_ID, "stream_player", "/test/imu/data", false);
+    // One bad IMU sample and an empty GNSS epoch first: counted and dropped, the node
+    // stays up.
+    let (bad_counted, _) = peer.wait_until_inputs_heard();
     let Peer {
         node: _peer,
         imu: imu_pub,
@@ -56,45 +59,7 @@ fn node_estimates_a_static_receiver() {
         diagnostics: diag_sub,
         tf: tf_sub,
         ..
-    } = Peer::matched(DOMAIN_ID, "stream_player", "/test/imu/data", false);
-
-    // One bad IMU sample first: counted and dropped, the node stays up.
-    let bad: Imu = outbound::imu(
-        &adaptive_gnss_ins::ins::ImuSample {
-            t_s: 0.0,
-            w_ib_b_rad_s: nalgebra::Vector3::new(f64::NAN, 0.0, 0.0),
-            f_ib_b_m_s2: nalgebra::Vector3::zeros(),
-        },
-        seconds_to_time(0.0).unwrap(),
-        "imu_link",
-    );
-    // An empty GNSS epoch, rejected by the engine for having no satellites.
-    let empty = GnssMeasurements::default();
-    // Our side having matched does not mean the node's readers have matched our writers
-    // yet (best effort drops what it sends before): repeat the bad messages until the
-    // node's diagnostics count both, which proves both input paths are up before streaming.
-    let key_value = |d: &DiagnosticArray, key: &str| {
-        d.status[0]
-            .values
-            .iter()
-            .find(|kv| kv.key == key)
-            .and_then(|kv| kv.value.parse::<u64>().ok())
-    };
-    let deadline = Instant::now() + Duration::from_secs(20);
-    let (mut bad_counted, mut empty_counted) = (0, 0);
-    while bad_counted == 0 || empty_counted == 0 {
-        assert!(
-            Instant::now() < deadline,
-            "the node never reported the bad IMU sample and the empty GNSS epoch"
-        );
-        imu_pub.publish(bad.clone()).unwrap();
-        gnss_pub.publish(empty.clone()).unwrap();
-        std::thread::sleep(Duration::from_millis(250));
-        while let Ok(Some((d, _))) = diag_sub.take() {
-            bad_counted = key_value(&d, "unconvertible_imu").unwrap_or(0);
-            empty_counted = key_value(&d, "rejected_gnss_no_satellites").unwrap_or(0);
-        }
-    }
+    } = peer;
     let stream = |until_s: f64| {
         let start = Instant::now();
         let (mut imu_sent, mut gnss_sent) = (0u64, 0u64);
@@ -211,13 +176,7 @@ fn node_estimates_a_static_receiver() {
     );
 
     let diagnostics = last_diagnostics.expect("no /diagnostics received");
-    let value = |key: &str| {
-        diagnostics.status[0]
-            .values
-            .iter()
-            .find(|kv| kv.key == key)
-            .map(|kv| kv.value.clone())
-    };
+    let value = |key: &str| diagnostic_value(&diagnostics, key);
     eprintln!("diagnostics: {:?}", diagnostics.status[0].values);
     assert_eq!(value("phase").as_deref(), Some("running"));
     let unconvertible: u64 = value("unconvertible_imu").unwrap().parse().unwrap();
@@ -251,11 +210,7 @@ fn node_estimates_a_static_receiver() {
             after += 1;
         }
         while let Ok(Some((d, _))) = diag_sub.take() {
-            resets = d.status[0]
-                .values
-                .iter()
-                .find(|kv| kv.key == "time_jump_resets")
-                .map(|kv| kv.value.clone());
+            resets = diagnostic_value(&d, "time_jump_resets");
         }
         std::thread::sleep(Duration::from_millis(20));
     }

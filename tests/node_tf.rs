@@ -14,14 +14,13 @@ use std::time::{Duration, Instant};
 
 use adaptive_gnss_ins::ros::convert::seconds_to_time;
 use adaptive_gnss_ins::ros::msg::{
-    DiagnosticArray, GnssMeasurements, Header, Odometry, Quaternion, TFMessage, Time,
-    TransformStamped, Vector3,
+    GnssMeasurements, Header, Odometry, Quaternion, TFMessage, Time, TransformStamped, Vector3,
 };
 use adaptive_gnss_ins::ros::outbound;
 use adaptive_gnss_ins::sim::SimEvent;
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 use netns_support::reexec_in_private_netns;
-use static_node_support::{start_node, static_scenario, Peer};
+use static_node_support::{diagnostic_count, start_node, static_scenario, Peer};
 
 const DOMAIN_ID: u16 = 19;
 /// Scenario seconds streamed, and how much faster than real time.
@@ -124,13 +123,6 @@ fn map_to_odom_chained_with_the_controllers_odom_is_the_fused_pose() {
     // Our side having matched does not mean the node's best-effort readers have matched
     // our writers: repeat the controller's first transform and an empty GNSS epoch until
     // the node's diagnostics count both.
-    let key_value = |d: &DiagnosticArray, key: &str| {
-        d.status[0]
-            .values
-            .iter()
-            .find(|kv| kv.key == key)
-            .and_then(|kv| kv.value.parse::<u64>().ok())
-    };
     let deadline = Instant::now() + Duration::from_secs(20);
     let (mut tf_heard, mut gnss_heard) = (0, 0);
     while tf_heard == 0 || gnss_heard == 0 {
@@ -143,8 +135,8 @@ fn map_to_odom_chained_with_the_controllers_odom_is_the_fused_pose() {
         gnss_pub.publish(GnssMeasurements::default()).unwrap();
         std::thread::sleep(Duration::from_millis(250));
         while let Ok(Some((d, _))) = diag_sub.take() {
-            tf_heard = key_value(&d, "odom_tf_received").unwrap_or(0);
-            gnss_heard = key_value(&d, "gnss_received").unwrap_or(0);
+            tf_heard = diagnostic_count(&d, "odom_tf_received").unwrap_or(0);
+            gnss_heard = diagnostic_count(&d, "gnss_received").unwrap_or(0);
         }
     }
 
@@ -264,7 +256,7 @@ fn map_to_odom_chained_with_the_controllers_odom_is_the_fused_pose() {
     assert!(offset.x.hypot(offset.y) > 5.0, "map -> odom {offset:?}");
 
     let diagnostics = last_diagnostics.expect("no /diagnostics received");
-    let value = |key: &str| key_value(&diagnostics, key);
+    let value = |key: &str| diagnostic_count(&diagnostics, key);
     eprintln!("diagnostics: {:?}", diagnostics.status[0].values);
     assert!(value("odom_tf_received").unwrap() >= controller_sent);
     assert_eq!(value("odom_tf_unusable"), Some(0));

@@ -38,7 +38,7 @@ use adaptive_gnss_ins::tools::convert::{
 };
 use adaptive_gnss_ins::tools::convert_bag::{RobotBag, RobotBagTopics};
 use adaptive_gnss_ins::tools::replay::{replay, ReplayOptions, TruthSource};
-use netns_support::{reexec_in_private_netns, KillOnDrop};
+use netns_support::{reexec_in_private_netns, rss_kb, KillOnDrop};
 use odometry_support::{decoded, largest_difference_of_runs};
 use ros2_client::{
     Context, ContextOptions, MessageTypeName, Name, Node, NodeName, NodeOptions, Publisher,
@@ -480,16 +480,6 @@ fn ubx_node_refuses_a_parameter_it_does_not_have() {
         ),
         "{stderr}"
     );
-}
-
-/// Resident memory (kB) of process `pid`.
-fn rss_kb(pid: u32) -> u64 {
-    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap();
-    status
-        .lines()
-        .find_map(|l| l.strip_prefix("VmRSS:"))
-        .and_then(|v| v.trim().trim_end_matches(" kB").trim().parse().ok())
-        .unwrap()
 }
 
 /// Issue 13's soak, run by hand (10 minutes; numbers in docs/ubx_node.md):

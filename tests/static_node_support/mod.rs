@@ -6,11 +6,13 @@
 #![allow(dead_code)]
 
 use std::process::{Command, Stdio};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
+use adaptive_gnss_ins::ros::convert::seconds_to_time;
 use adaptive_gnss_ins::ros::msg::{
     DiagnosticArray, GnssMeasurements, Imu, Odometry, RosMessage, TFMessage,
 };
+use adaptive_gnss_ins::ros::outbound;
 use adaptive_gnss_ins::sim::Scenario;
 use ros2_client::{
     Context, ContextOptions, MessageTypeName, Name, NodeName, NodeOptions, Publisher, QosProfile,
@@ -46,7 +48,8 @@ pub fn start_node(domain_id: u16, scenario: &Scenario, extra: &[&str]) -> KillOn
     KillOnDrop(node)
 }
 
-fn type_name<M: RosMessage>() -> MessageTypeName {
+/// The DDS type name of `M`.
+pub fn type_name<M: RosMessage>() -> MessageTypeName {
     let parts: Vec<&str> = M::TYPE_NAME.split('/').collect();
     MessageTypeName::new(parts[0], parts[2])
 }
@@ -122,4 +125,52 @@ impl Peer {
         assert!(matched, "the node's topics were not discovered within 20 s");
         peer
     }
+
+    /// Our side having matched does not mean the node's readers have matched our writers
+    /// yet (best effort drops what it sends before): sends an IMU sample with a NaN
+    /// (dropped as unconvertible) and an empty GNSS epoch (rejected for having no
+    /// satellites) until the node's diagnostics count both, which proves both input paths
+    /// are up. Returns the two counts then; panics after 20 s.
+    pub fn wait_until_inputs_heard(&self) -> (u64, u64) {
+        let bad = outbound::imu(
+            &adaptive_gnss_ins::ins::ImuSample {
+                t_s: 0.0,
+                w_ib_b_rad_s: nalgebra::Vector3::new(f64::NAN, 0.0, 0.0),
+                f_ib_b_m_s2: nalgebra::Vector3::zeros(),
+            },
+            seconds_to_time(0.0).unwrap(),
+            "imu_link",
+        );
+        let empty = GnssMeasurements::default();
+        let deadline = Instant::now() + Duration::from_secs(20);
+        let (mut bad_counted, mut empty_counted) = (0, 0);
+        while bad_counted == 0 || empty_counted == 0 {
+            assert!(
+                Instant::now() < deadline,
+                "the node never reported the bad IMU sample and the empty GNSS epoch"
+            );
+            self.imu.publish(bad.clone()).unwrap();
+            self.gnss.publish(empty.clone()).unwrap();
+            std::thread::sleep(Duration::from_millis(250));
+            while let Ok(Some((d, _))) = self.diagnostics.take() {
+                bad_counted = diagnostic_count(&d, "unconvertible_imu").unwrap_or(0);
+                empty_counted = diagnostic_count(&d, "rejected_gnss_no_satellites").unwrap_or(0);
+            }
+        }
+        (bad_counted, empty_counted)
+    }
+}
+
+/// The value of `key` in the node's /diagnostics report `d`.
+pub fn diagnostic_value(d: &DiagnosticArray, key: &str) -> Option<String> {
+    d.status[0]
+        .values
+        .iter()
+        .find(|kv| kv.key == key)
+        .map(|kv| kv.value.clone())
+}
+
+/// The counter `key` of the node's /diagnostics report `d`.
+pub fn diagnostic_count(d: &DiagnosticArray, key: &str) -> Option<u64> {
+    diagnostic_value(d, key).and_then(|v| v.parse().ok())
 }
