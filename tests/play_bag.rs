@@ -203,6 +203,47 @@ fn loose_node_with_velocities_records_the_replay_solution() {
     assert_eq!(replayed.velocities().paired, summary.velocities as u64);
 }
 
+/// Starts `gnss_ins_node --record recorded --ros-args node_args` on domain `domain`, plays
+/// `bag` into it with `play_args` (after the player's `--delay`), and stops the node with
+/// SIGINT, as Ctrl-C: it completes the recording and must exit cleanly.
+fn record_node_playing(
+    bag: &Path,
+    recorded: &Path,
+    node_args: &[String],
+    play_args: &[&str],
+    domain: &str,
+) {
+    let node = Command::new(env!("CARGO_BIN_EXE_gnss_ins_node"))
+        .arg("--record")
+        .arg(recorded)
+        .arg("--ros-args")
+        .args(node_args)
+        .env("ROS_DOMAIN_ID", domain)
+        .env("RUST_LOG", "info,rustdds=error,ros2_client=warn")
+        .spawn()
+        .unwrap();
+    let status = Command::new(env!("CARGO_BIN_EXE_gnss_ins"))
+        .arg("play")
+        .arg(bag)
+        .args(play_args)
+        .args(["--delay", PLAYER_DELAY_S])
+        .env("ROS_DOMAIN_ID", domain)
+        .env("RUST_LOG", "warn,rustdds=error")
+        .stdout(Stdio::null())
+        .status()
+        .unwrap();
+    assert!(status.success(), "gnss_ins play failed: {status}");
+    std::thread::sleep(Duration::from_secs(1));
+    let kill = Command::new("kill")
+        .args(["-INT", &node.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let mut node = node;
+    let exit = node.wait().unwrap();
+    assert!(exit.success(), "the node did not stop cleanly: {exit}");
+}
+
 /// Plays `bag` into `gnss_ins_node --record` (the default parameters but `overrides`,
 /// domain `DOMAIN_ID + domain_offset`) and checks its Odometry against `gnss_ins replay`
 /// of the bag with the same parameters; returns the replay's result.
@@ -216,40 +257,13 @@ fn node_records_the_replay_solution(
     let recorded = dir.path().join("node.mcap");
     let replayed = dir.path().join("replay.mcap");
     let domain = (DOMAIN_ID + domain_offset).to_string();
-    let mut node = Command::new(env!("CARGO_BIN_EXE_gnss_ins_node"));
-    node.arg("--record")
-        .arg(&recorded)
-        .args(["--ros-args", "-r", "__node:=recorder_test"]);
+    let mut node_args = vec!["-r".to_owned(), "__node:=recorder_test".to_owned()];
     for (name, value) in overrides {
-        node.arg("-p").arg(format!("{name}:={value}"));
+        node_args.extend(["-p".to_owned(), format!("{name}:={value}")]);
     }
-    let node = node
-        .env("ROS_DOMAIN_ID", &domain)
-        .env("RUST_LOG", "info,rustdds=error,ros2_client=warn")
-        .spawn()
-        .unwrap();
-    let status = Command::new(env!("CARGO_BIN_EXE_gnss_ins"))
-        .arg("play")
-        .arg(bag)
-        .args(["--rate", "2"])
-        .args(wait_for.iter().flat_map(|t| ["--wait-for", t]))
-        .args(["--delay", PLAYER_DELAY_S])
-        .env("ROS_DOMAIN_ID", &domain)
-        .env("RUST_LOG", "warn,rustdds=error")
-        .stdout(Stdio::null())
-        .status()
-        .unwrap();
-    assert!(status.success(), "gnss_ins play failed: {status}");
-    std::thread::sleep(Duration::from_secs(1));
-    // SIGINT, as Ctrl-C: the node completes the bag and exits cleanly.
-    let kill = Command::new("kill")
-        .args(["-INT", &node.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(kill.success());
-    let mut node = node;
-    let exit = node.wait().unwrap();
-    assert!(exit.success(), "the node did not stop cleanly: {exit}");
+    let mut play_args = vec!["--rate", "2"];
+    play_args.extend(wait_for.iter().flat_map(|t| ["--wait-for", t]));
+    record_node_playing(bag, &recorded, &node_args, &play_args, &domain);
 
     let topics: Vec<String> = BagReader::open(&recorded)
         .unwrap()
@@ -352,36 +366,22 @@ fn node_joining_a_drive_in_its_middle_converges_to_the_truth() {
         spec.start_lat_deg, spec.start_lon_deg, spec.start_height_m
     );
     let domain = (DOMAIN_ID + 3).to_string();
-    let node = Command::new(env!("CARGO_BIN_EXE_gnss_ins_node"))
-        .arg("--record")
-        .arg(&recorded)
-        .args(["--ros-args", "-r", "__node:=mid_drive_test", "-p", &datum])
-        .env("ROS_DOMAIN_ID", &domain)
-        .env("RUST_LOG", "info,rustdds=error,ros2_client=warn")
-        .spawn()
-        .unwrap();
-    let status = Command::new(env!("CARGO_BIN_EXE_gnss_ins"))
-        .arg("play")
-        .arg(&bag)
-        .args(["--rate", "5", "--start-offset", JOIN_AT_S])
-        .args(["--wait-for", "/imu", "--wait-for", "/gnss/measurements"])
-        .args(["--delay", PLAYER_DELAY_S])
-        .env("ROS_DOMAIN_ID", &domain)
-        .env("RUST_LOG", "warn,rustdds=error")
-        .stdout(Stdio::null())
-        .status()
-        .unwrap();
-    assert!(status.success(), "gnss_ins play failed: {status}");
-    std::thread::sleep(Duration::from_secs(1));
-    let kill = Command::new("kill")
-        .args(["-INT", &node.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(kill.success());
-    let mut node = node;
-    assert!(
-        node.wait().unwrap().success(),
-        "the node did not stop cleanly"
+    let node_args = ["-r", "__node:=mid_drive_test", "-p", &datum].map(str::to_owned);
+    record_node_playing(
+        &bag,
+        &recorded,
+        &node_args,
+        &[
+            "--rate",
+            "5",
+            "--start-offset",
+            JOIN_AT_S,
+            "--wait-for",
+            "/imu",
+            "--wait-for",
+            "/gnss/measurements",
+        ],
+        &domain,
     );
 
     let truth: std::collections::HashMap<i64, Odometry> =
