@@ -17,7 +17,9 @@ use adaptive_gnss_ins::ros::convert::seconds_to_time;
 use adaptive_gnss_ins::ros::outbound;
 use adaptive_gnss_ins::sim::SimEvent;
 use netns_support::reexec_in_private_netns;
-use static_node_support::{diagnostic_value, start_node, static_scenario, Peer};
+use static_node_support::{
+    collect_outputs, diagnostic_value, start_node, static_scenario, Outputs, Peer,
+};
 
 const DOMAIN_ID: u16 = 17;
 /// Position budget of the ekf preset on a static receiver after a minute of 1 Hz GNSS,
@@ -95,22 +97,11 @@ fn node_estimates_a_static_receiver() {
     let (imu_sent, gnss_sent) = stream(STREAM_S);
 
     // Collect what the node published.
-    let deadline = Instant::now() + Duration::from_secs(3);
-    let mut odometry = Vec::new();
-    let mut transforms = Vec::new();
-    let mut last_diagnostics = None;
-    while Instant::now() < deadline {
-        while let Ok(Some((o, _))) = odom_sub.take() {
-            odometry.push(o);
-        }
-        while let Ok(Some((t, _))) = tf_sub.take() {
-            transforms.extend(t.transforms);
-        }
-        while let Ok(Some((d, _))) = diag_sub.take() {
-            last_diagnostics = Some(d);
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
+    let Outputs {
+        odometry,
+        transforms,
+        last_diagnostics,
+    } = collect_outputs(&odom_sub, &tf_sub, &diag_sub, 3);
     // One Odometry per IMU sample from the initialization at 1 s: about 5900.
     assert!(
         odometry.len() > 5000,

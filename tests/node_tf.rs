@@ -20,7 +20,9 @@ use adaptive_gnss_ins::ros::outbound;
 use adaptive_gnss_ins::sim::SimEvent;
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 use netns_support::reexec_in_private_netns;
-use static_node_support::{diagnostic_count, start_node, static_scenario, Peer};
+use static_node_support::{
+    collect_outputs, diagnostic_count, start_node, static_scenario, Outputs, Peer,
+};
 
 const DOMAIN_ID: u16 = 19;
 /// Scenario seconds streamed, and how much faster than real time.
@@ -172,22 +174,11 @@ fn map_to_odom_chained_with_the_controllers_odom_is_the_fused_pose() {
         }
     }
 
-    let deadline = Instant::now() + Duration::from_secs(3);
-    let mut odometry = Vec::new();
-    let mut transforms = Vec::new();
-    let mut last_diagnostics = None;
-    while Instant::now() < deadline {
-        while let Ok(Some((o, _))) = odom_sub.take() {
-            odometry.push(o);
-        }
-        while let Ok(Some((t, _))) = tf_sub.take() {
-            transforms.extend(t.transforms);
-        }
-        while let Ok(Some((d, _))) = diag_sub.take() {
-            last_diagnostics = Some(d);
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
+    let Outputs {
+        odometry,
+        transforms,
+        last_diagnostics,
+    } = collect_outputs(&odom_sub, &tf_sub, &diag_sub, 3);
 
     // base_link has one parent: the controller's odom. Everything else on /tf is the
     // node's map -> odom.

@@ -174,3 +174,40 @@ pub fn diagnostic_value(d: &DiagnosticArray, key: &str) -> Option<String> {
 pub fn diagnostic_count(d: &DiagnosticArray, key: &str) -> Option<u64> {
     diagnostic_value(d, key).and_then(|v| v.parse().ok())
 }
+
+/// What the node published in the last few seconds: every Odometry and transform, and
+/// the newest /diagnostics.
+pub struct Outputs {
+    pub odometry: Vec<Odometry>,
+    pub transforms: Vec<adaptive_gnss_ins::ros::msg::TransformStamped>,
+    pub last_diagnostics: Option<DiagnosticArray>,
+}
+
+/// Takes what the subscriptions receive for `for_s` seconds (the node's queues draining
+/// after the stream ended).
+pub fn collect_outputs(
+    odometry: &Subscription<Odometry>,
+    tf: &Subscription<TFMessage>,
+    diagnostics: &Subscription<DiagnosticArray>,
+    for_s: u64,
+) -> Outputs {
+    let deadline = std::time::Instant::now() + Duration::from_secs(for_s);
+    let mut out = Outputs {
+        odometry: Vec::new(),
+        transforms: Vec::new(),
+        last_diagnostics: None,
+    };
+    while std::time::Instant::now() < deadline {
+        while let Ok(Some((o, _))) = odometry.take() {
+            out.odometry.push(o);
+        }
+        while let Ok(Some((t, _))) = tf.take() {
+            out.transforms.extend(t.transforms);
+        }
+        while let Ok(Some((d, _))) = diagnostics.take() {
+            out.last_diagnostics = Some(d);
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    out
+}
