@@ -15,6 +15,7 @@ use std::path::Path;
 use adaptive_gnss_ins::config::Config;
 use adaptive_gnss_ins::engine::RejectionReason;
 use adaptive_gnss_ins::eval::SolutionError;
+use adaptive_gnss_ins::ros::adapter::Input;
 use adaptive_gnss_ins::ros::bag::{BagReader, BagWriter};
 use adaptive_gnss_ins::ros::cdr;
 use adaptive_gnss_ins::ros::msg::Odometry;
@@ -102,12 +103,12 @@ fn replay_feeds_the_wheel_odometry_of_a_bag_when_enabled() {
     let without = replay_scored(&plain, &car_config(false));
 
     assert!(added > 2000, "{added}");
-    assert_eq!(on.counts.wheel_odometry_received, added);
+    assert_eq!(on.counts.stream(Input::WheelOdometry).received, added);
     assert_eq!(on.problems.used(WHEEL_ODOMETRY_TOPIC), added);
-    assert_eq!(on.counts.unconvertible_wheel_odometry, 0);
+    assert_eq!(on.counts.stream(Input::WheelOdometry).unconvertible, 0);
     let before_start = on.rejections.count(RejectionReason::WheelSpeedBeforeStart);
     assert_eq!(on.rejections.total(), before_start, "{:?}", on.rejections);
-    assert_eq!(off.counts.wheel_odometry_received, 0);
+    assert_eq!(off.counts.stream(Input::WheelOdometry).received, 0);
     assert_eq!(
         off.problems.unfed_inputs.get(WHEEL_ODOMETRY_TOPIC),
         Some(&added)

@@ -67,7 +67,7 @@ impl BagRun {
         VelocityCounts {
             paired: self.counts.velocity_paired,
             unpaired: self.unpaired_velocities,
-            foreign_frame: self.counts.foreign_frame_velocity,
+            foreign_frame: self.counts.stream(Input::Velocity).foreign_frame,
         }
     }
 
@@ -100,8 +100,11 @@ impl BagRun {
         .map(|r| self.rejections.count(r))
         .sum();
         let c = &self.counts;
-        let dropped = undecodable + c.unconvertible_imu + c.foreign_frame_imu + rejected;
-        (dropped, c.imu_received + undecodable)
+        let dropped = undecodable
+            + c.stream(Input::Imu).unconvertible
+            + c.stream(Input::Imu).foreign_frame
+            + rejected;
+        (dropped, c.stream(Input::Imu).received + undecodable)
     }
 }
 

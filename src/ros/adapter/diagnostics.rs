@@ -23,7 +23,7 @@ impl RosAdapter {
             key_value("imu_frame", self.imu_frame.locked().to_owned()),
         ];
         for (key, n) in self.counts.named() {
-            values.push(key_value(key, n.to_string()));
+            values.push(key_value(&key, n.to_string()));
             if key == "velocity_paired" {
                 let unpaired = self.unpaired_velocities().to_string();
                 values.push(key_value("unpaired_velocity", unpaired));

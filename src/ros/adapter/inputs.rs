@@ -53,7 +53,7 @@ impl RosAdapter {
 
     /// Handles one sensor_msgs/Imu.
     pub fn on_imu(&mut self, msg: &Imu) -> Vec<Published> {
-        self.counts.imu_received += 1;
+        self.counts.stream_mut(Input::Imu).received += 1;
         let sample = match ImuSample::try_from(msg) {
             Ok(s) => s,
             Err(e) => return self.unconvertible(Input::Imu, &e.to_string()),
@@ -120,7 +120,7 @@ impl RosAdapter {
 
     /// Handles one GnssMeasurements (tight coupling).
     pub fn on_gnss(&mut self, msg: &GnssMeasurements) -> Vec<Published> {
-        self.counts.gnss_received += 1;
+        self.counts.stream_mut(Input::Gnss).received += 1;
         let epoch = match GnssEpoch::try_from(msg) {
             Ok(e) => e,
             Err(e) => return self.unconvertible(Input::Gnss, &e.to_string()),
@@ -160,7 +160,7 @@ impl RosAdapter {
     /// Handles one NavSatFix (loose coupling); a fix without a solution is counted and
     /// dropped.
     pub fn on_fix(&mut self, msg: &NavSatFix) -> Vec<Published> {
-        self.counts.fix_received += 1;
+        self.counts.stream_mut(Input::Fix).received += 1;
         let fix = match GnssFix::try_from(msg) {
             Ok(f) => f,
             Err(e) => return self.unconvertible(Input::Fix, &e.to_string()),
@@ -186,7 +186,7 @@ impl RosAdapter {
     /// [`FixVelocityJoin`](crate::ros::fix_velocity::FixVelocityJoin): in the map frame or
     /// the fix's frame). Any other frame is counted and the fix goes on without it.
     pub fn on_velocity(&mut self, msg: &TwistWithCovarianceStamped) -> Vec<Published> {
-        self.counts.velocity_received += 1;
+        self.counts.stream_mut(Input::Velocity).received += 1;
         let velocity = match GnssVelocity::try_from(msg) {
             Ok(v) => v,
             Err(e) => return self.unconvertible(Input::Velocity, &e.to_string()),
@@ -200,7 +200,7 @@ impl RosAdapter {
     /// it unless `wheel_odometry.enabled`. The stream is locked to one `child_frame_id`,
     /// the frame of the twist.
     pub fn on_wheel_odometry(&mut self, msg: &Odometry) -> Vec<Published> {
-        self.counts.wheel_odometry_received += 1;
+        self.counts.stream_mut(Input::WheelOdometry).received += 1;
         let speed = match WheelOdometrySpeed::try_from(msg) {
             Ok(s) => s,
             Err(e) => return self.unconvertible(Input::WheelOdometry, &e.to_string()),
@@ -264,7 +264,7 @@ impl RosAdapter {
 
     /// Counts and logs a message of `input` that did not convert.
     fn unconvertible(&mut self, input: Input, error: &str) -> Vec<Published> {
-        *self.counts.unconvertible(input) += 1;
+        self.counts.stream_mut(input).unconvertible += 1;
         let name = input.name();
         self.log.warn(
             &format!("unconvertible {name}"),
@@ -285,7 +285,7 @@ impl RosAdapter {
             ),
             Input::WheelOdometry => format!("child frame `{}`", self.wheel_frame.locked()),
         };
-        *self.counts.foreign_frame(input) += 1;
+        self.counts.stream_mut(input).foreign_frame += 1;
         let name = input.name();
         self.log.warn(
             &format!("foreign frame {name}"),
@@ -297,7 +297,7 @@ impl RosAdapter {
     /// Counts and logs that the stream of `input` now follows `frame_id` (its locked frame
     /// went silent).
     fn frame_switched(&mut self, input: Input, frame_id: &str) {
-        *self.counts.frame_switches(input) += 1;
+        self.counts.stream_mut(input).frame_switches += 1;
         let name = input.name();
         log::warn!("{name}: the locked frame went silent; now following frame `{frame_id}`");
     }

@@ -89,8 +89,12 @@ fn bad_inputs_are_counted_and_dropped() {
     let mut no_fix = NavSatFix::default();
     no_fix.status.status = -1;
     assert!(adapter.on_fix(&no_fix).is_empty());
-    assert_eq!(adapter.counts().unconvertible_imu, 2, "NaN and a bad stamp");
-    assert_eq!(adapter.counts().unconvertible_fix, 1);
+    assert_eq!(
+        adapter.counts().stream(Input::Imu).unconvertible,
+        2,
+        "NaN and a bad stamp"
+    );
+    assert_eq!(adapter.counts().stream(Input::Fix).unconvertible, 1);
     assert_eq!(adapter.counts().undecodable, 1);
     assert_eq!(
         diagnostic(&adapter, "unconvertible_imu").as_deref(),
@@ -112,7 +116,7 @@ fn a_second_imu_frame_is_counted_and_dropped() {
     let mut other = imu_at(10.505);
     other.header.frame_id = "other_imu".to_owned();
     assert!(adapter.on_imu(&other).is_empty());
-    assert_eq!(adapter.counts().foreign_frame_imu, 1);
+    assert_eq!(adapter.counts().stream(Input::Imu).foreign_frame, 1);
     assert_eq!(
         adapter.engine().last_imu_t_s(),
         Some(10.49),
@@ -155,10 +159,10 @@ fn loose_coupling_runs_on_fixes_and_counts_raw_epochs_as_wrong_coupling() {
             .any(|m| messages(m).is_some_and(|m| m.tf.is_some()));
     });
     assert!(odometry > 2000, "{odometry} odometry messages in 30 s");
-    assert_eq!(adapter.counts().velocity_received, 0);
+    assert_eq!(adapter.counts().stream(Input::Velocity).received, 0);
     assert!(!out_had_tf, "no /tf without publish_tf");
     assert_eq!(adapter.engine().init_phase(), None, "running");
-    assert_eq!(adapter.counts().unconvertible_fix, 0);
+    assert_eq!(adapter.counts().stream(Input::Fix).unconvertible, 0);
     assert_eq!(
         adapter
             .engine()
@@ -249,10 +253,10 @@ fn velocities_pair_with_their_fixes_bad_ones_are_counted_and_tf_follows_odometry
     });
     let c = adapter.counts();
     assert!(fixes > 25, "{fixes} fixes");
-    assert_eq!(c.velocity_received, fixes as u64 + 2);
+    assert_eq!(c.stream(Input::Velocity).received, fixes as u64 + 2);
     assert_eq!(c.velocity_paired, paired);
-    assert_eq!(c.unconvertible_velocity, 1, "NaN");
-    assert_eq!(c.foreign_frame_velocity, 1);
+    assert_eq!(c.stream(Input::Velocity).unconvertible, 1, "NaN");
+    assert_eq!(c.stream(Input::Velocity).foreign_frame, 1);
     assert_eq!(adapter.unpaired_velocities(), 2, "repeated and fix-less");
     assert_eq!(
         diagnostic(&adapter, "unpaired_velocity").as_deref(),
@@ -391,11 +395,11 @@ fn stray_imu_samples_sent_first_do_not_lock_out_the_imu() {
         }
     });
     let c = adapter.counts();
-    assert_eq!(c.frame_switches_imu, 1);
+    assert_eq!(c.stream(Input::Imu).frame_switches, 1);
     assert!(
-        c.foreign_frame_imu > 0 && c.foreign_frame_imu < 1000,
+        c.stream(Input::Imu).foreign_frame > 0 && c.stream(Input::Imu).foreign_frame < 1000,
         "the real IMU waited {} samples",
-        c.foreign_frame_imu
+        c.stream(Input::Imu).foreign_frame
     );
     assert_eq!(adapter.engine().init_phase(), None, "running");
     assert!(solutions > 2000, "{solutions} solutions");
@@ -424,8 +428,8 @@ fn a_configured_imu_frame_admits_no_other_and_reports_the_conflict() {
         }
         n += 1;
     });
-    assert_eq!(adapter.counts().foreign_frame_imu, strays);
-    assert_eq!(adapter.counts().frame_switches_imu, 0);
+    assert_eq!(adapter.counts().stream(Input::Imu).foreign_frame, strays);
+    assert_eq!(adapter.counts().stream(Input::Imu).frame_switches, 0);
     assert_eq!(adapter.engine().init_phase(), None, "running");
     assert!(solutions > 2000, "{solutions} solutions");
     let (level, message) = level(&adapter);
@@ -443,7 +447,7 @@ fn a_configured_imu_frame_admits_no_other_and_reports_the_conflict() {
         }
         n += 1;
     });
-    assert_eq!(adapter.counts().frame_switches_imu, 0);
+    assert_eq!(adapter.counts().stream(Input::Imu).frame_switches, 0);
     assert_eq!(adapter.engine().init_phase(), None, "running");
 }
 
