@@ -162,7 +162,7 @@ struct Attitude {
 }
 
 /// The start-up state machine.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone)]
 pub struct Initializer {
     leveling: Option<Leveling>,
     /// The newest IMU sample seen (a late measurement re-feeds the buffered samples: each
@@ -176,7 +176,37 @@ pub struct Initializer {
     moving_fixes: usize,
     /// The newest GNSS velocity.
     velocity: Option<GnssVelocity>,
+    /// The gyro bias prior's σ when the bias is not measured at rest, in multiples of the
+    /// IMU class's `imu.gyro_bias_deg_per_h` (1, or [`DIVERGED_GYRO_BIAS_SIGMA_FACTOR`]
+    /// after a divergence).
+    gyro_bias_sigma_factor: f64,
 }
+
+impl Default for Initializer {
+    fn default() -> Self {
+        Self {
+            leveling: None,
+            last_imu_t_s: None,
+            attitude: None,
+            position_known: false,
+            fixes: FixTrack::default(),
+            moving_fixes: 0,
+            velocity: None,
+            gyro_bias_sigma_factor: 1.0,
+        }
+    }
+}
+
+/// The gyro bias prior's σ after a divergence, in multiples of the class's turn-on σ.
+///
+/// Choice: ten. A filter that diverged while GNSS was there has met an IMU error its
+/// model did not hold (a bias that jumped with temperature or a knock, a fault): the
+/// class's σ has just failed to cover it, so the restart allows an order of magnitude
+/// more, which the GNSS then narrows within tens of seconds of driving. Measured in
+/// tests/divergence_monitor.rs: a consumer-MEMS gyro whose biases jump to ten times their
+/// value (1–4 °/s) keeps the NEES of the restarted filter 5–17 against a 3σ bound of
+/// 25; with the class's σ it reached 1,100.
+pub const DIVERGED_GYRO_BIAS_SIGMA_FACTOR: f64 = 10.0;
 
 impl Initializer {
     /// Keeps what was learned about the attitude (after a reset the filter restarts from
@@ -195,6 +225,26 @@ impl Initializer {
             }),
             ..Self::default()
         }
+    }
+
+    /// Starts again from nothing after a divergence, with a wide gyro bias prior
+    /// ([`DIVERGED_GYRO_BIAS_SIGMA_FACTOR`]).
+    ///
+    /// Choice: unlike after an IMU gap, the attitude and gyro bias are not kept: a filter
+    /// that diverged with GNSS present had them wrong (a gyro fault tilts and turns it by
+    /// degrees while its σ says tenths), and a restart from them stays over-confident for
+    /// minutes. The start-up aligns again — at rest by levelling, in motion from the GNSS
+    /// course and the specific force (with the heading bank where configured).
+    pub fn after_divergence() -> Self {
+        Self {
+            gyro_bias_sigma_factor: DIVERGED_GYRO_BIAS_SIGMA_FACTOR,
+            ..Self::default()
+        }
+    }
+
+    /// The σ of a gyro bias not measured at rest (rad/s).
+    fn turn_on_gyro_bias_sigma_rad_s(&self, config: &Config) -> f64 {
+        config.imu.gyro_bias_sigma_rad_s * self.gyro_bias_sigma_factor
     }
 
     pub fn phase(&self) -> InitPhase {
@@ -465,7 +515,7 @@ impl Initializer {
         };
         let g = up.norm().max(1.0);
         let i = &config.init;
-        let sideways = config.imu.gyro_bias_sigma_rad_s * speed;
+        let sideways = self.turn_on_gyro_bias_sigma_rad_s(config) * speed;
         let heading_sigma = match config.init.heading_rad {
             Some(_) => i.heading_sigma_rad,
             None => v.course_sigma_rad().hypot(COURSE_SIGMA_RAD),
@@ -534,11 +584,12 @@ impl Initializer {
             .attitude
             .as_ref()
             .and_then(|a| a.at_rest.map(|_| config.init.leveling_duration_s));
-        let gb = levelled_s.map_or(config.imu.gyro_bias_sigma_rad_s, |t| {
+        let turn_on_sigma_rad_s = self.turn_on_gyro_bias_sigma_rad_s(config);
+        let gb = levelled_s.map_or(turn_on_sigma_rad_s, |t| {
             let measured = (config.imu.gyro_arw_rad_per_sqrt_s.powi(2) / t
                 + config.imu.gyro_markov_sigma_rad_s.powi(2))
             .sqrt();
-            config.imu.gyro_bias_sigma_rad_s.min(measured)
+            turn_on_sigma_rad_s.min(measured)
         });
         let gb = gb.powi(2);
         set3(&mut cov, GYRO_BIAS, [gb, gb, gb]);

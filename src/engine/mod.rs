@@ -31,8 +31,8 @@
 //!   lone spike is dropped and counted, and the strapdown step spans it.
 //! - Each GNSS input seen for the first time feeds the divergence monitor ([`divergence`],
 //!   [`recovery`]) with the prior's disagreement with an independent GNSS position; a
-//!   sustained one is counted and resets the filter as an IMU gap does (the attitude is
-//!   kept, position and velocity start again from GNSS).
+//!   sustained one is counted and resets the filter; unlike after an IMU gap nothing is
+//!   kept: the start-up aligns again, with a wide gyro bias prior.
 
 mod adaptation;
 pub mod adaptive_noise;
@@ -279,9 +279,13 @@ impl Engine {
     }
 
     /// Forgets everything (as after a time jump backwards) and starts again; the attitude
-    /// learned so far is kept when the filter was running.
+    /// learned so far is kept when the filter was running, unless it diverged (see
+    /// [`Initializer::after_divergence`]).
     pub fn reset(&mut self, t_s: f64, reason: ResetReason) -> Output {
         let init = match &self.phase {
+            Phase::Running(_) if reason == ResetReason::DivergedFromGnss => {
+                Box::new(Initializer::after_divergence())
+            }
             Phase::Running(s) => Box::new(Initializer::with_attitude(
                 s.nav.q_nb,
                 s.gyro_bias_rad_s + s.gyro_markov_rad_s,

@@ -51,8 +51,7 @@ impl Engine {
         );
         self.divergence_resets += 1;
         self.diverged_at_t_s = Some(t_s);
-        // Choice: as after an IMU gap, the attitude and gyro bias are kept and the position
-        // and velocity start again from GNSS.
+        // Nothing of the diverged state is kept (see Initializer::after_divergence).
         Some(self.reset(t_s, ResetReason::DivergedFromGnss))
     }
 }
