@@ -215,7 +215,13 @@ fn divergence_monitor_step(c: &mut Criterion) {
     c.bench_function("divergence_monitor_step_loose", |b| {
         b.iter(|| {
             state.nav.t_s += 1.0;
-            let d = Disagreement::of(black_box(&state), &fix, &fix_covariance_enu_m2, &config);
+            let d = Disagreement::of(
+                black_box(&state),
+                &fix,
+                &fix_covariance_enu_m2,
+                None,
+                &config,
+            );
             black_box(monitor.check(state.nav.t_s, Some(&d)))
         })
     });

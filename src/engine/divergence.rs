@@ -21,18 +21,21 @@
 //!
 //! - the disagreement did not appear as a GNSS jump: an offset that leaps beyond
 //!   [`DISAGREE_SIGMA`] between two consecutive epochs (at most [`MAX_EPOCH_GAP_S`] apart)
-//!   from an epoch that agreed is the GNSS moving, not the filter — the IMU cannot carry
-//!   the state that far beyond its own σ in a second, and a filter that drifts crosses
-//!   5σ in small steps. Such a disagreement (fixes biased by NLOS reception in a street
-//!   canyon, confidently wrong for a hundred seconds in tests/consumer_mems_drive.rs)
-//!   starts no run until an epoch agrees again. After an outage there is no epoch before
-//!   to compare with, and the drift of the outage is judged as above.
+//!   from an epoch that agreed is the GNSS moving, unless the GNSS velocity (Doppler, or
+//!   the receiver's) is beyond [`DISAGREE_SIGMA`] of the filter's: an IMU fault the
+//!   screening lets through (a burst of 4 g for half a second) makes the filter leap
+//!   within a second, and it gets there with a velocity error, while a position jump of
+//!   the GNSS (a reflection) leaves its Doppler velocity alone. A GNSS leap (fixes biased by NLOS reception in a street canyon,
+//!   confidently wrong for a hundred seconds in tests/consumer_mems_drive.rs) starts no
+//!   run until an epoch agrees again; a filter that drifts crosses 5σ in small steps.
+//!   After an outage there is no epoch before to compare with, and the drift of the
+//!   outage is judged as above.
 //!
 //! A wrong filter and the GNSS agreeing on that are what divergence is; one epoch that
-//! cannot be judged (no independent position) ends the run. Limits: a filter that jumps
-//! within a second (an IMU fault the screening lets through, a second after a GNSS
-//! epoch) is taken for a GNSS jump; a GNSS that is confidently wrong from the first epoch
-//! after an outage is taken for the truth.
+//! cannot be judged (no independent position) ends the run. Limits: a GNSS that is
+//! confidently wrong from the first epoch after an outage is taken for the truth; a
+//! filter that leaps within a second is taken for a GNSS jump when the GNSS gives no
+//! velocity (receiver fixes without one, loosely coupled).
 
 use nalgebra::{Matrix3, Vector3};
 
@@ -41,6 +44,7 @@ use super::output::position_covariance_enu_m2;
 use crate::config::Config;
 use crate::earth::{self, Llh};
 use crate::filter::measurement_rows::AntennaGeometry;
+use crate::ins::error_state::DV;
 
 /// Mahalanobis distance beyond which an epoch disagrees (σ of the combined covariance).
 ///
@@ -67,18 +71,26 @@ pub struct Disagreement {
     pub offset_enu_m: Vector3<f64>,
     /// The filter's position covariance plus the GNSS position's, ENU (m²).
     pub covariance_enu_m2: Matrix3<f64>,
+    /// The Mahalanobis distance (σ) of the GNSS velocity from the filter's, when the GNSS
+    /// gave a velocity: who moved when the offset leaps.
+    pub velocity_sigmas: Option<f64>,
 }
+
+/// A GNSS velocity, ENU (m/s), and its covariance (m²/s²).
+pub type GnssVelocityEnu = (Vector3<f64>, Matrix3<f64>);
 
 impl Disagreement {
     /// The filter's disagreement with the GNSS antenna position `gnss` of covariance
-    /// `gnss_covariance_enu_m2`.
+    /// `gnss_covariance_enu_m2`, and with the GNSS velocity when there is one.
     ///
-    /// Choice: the filter's covariance is that of its IMU position; the lever arm's share
-    /// through the attitude error (centimetres for a lever of a metre) is left out.
+    /// Choice: the filter's covariances are those of its IMU position and velocity; the
+    /// lever arm's share through the attitude error and the body rate (centimetres and
+    /// centimetres per second for a lever of a metre) is left out.
     pub fn of(
         prior: &FilterState,
         gnss: &Llh,
         gnss_covariance_enu_m2: &Matrix3<f64>,
+        gnss_velocity: Option<&GnssVelocityEnu>,
         config: &Config,
     ) -> Self {
         // The body rate moves only the antenna's velocity, not its position.
@@ -86,21 +98,38 @@ impl Disagreement {
         let geo = AntennaGeometry::new(&prior.nav, &config.mounting.lever_arm_b_m, &no_rate);
         let rot = earth::rot_ecef_to_enu(&prior.nav.p);
         let antenna_ecef_m = geo.antenna_ecef_m(&prior.nav.p);
+        let velocity_sigmas = gnss_velocity.and_then(|(v_enu_mps, cov_enu_m2_s2)| {
+            let filter_cov: Matrix3<f64> = prior.p.fixed_view::<3, 3>(DV, DV).into();
+            mahalanobis(&(v_enu_mps - prior.nav.v_n), &(filter_cov + cov_enu_m2_s2))
+        });
         Self {
             t_s: prior.nav.t_s,
             offset_enu_m: rot * (earth::llh_to_ecef(gnss) - antenna_ecef_m),
             covariance_enu_m2: position_covariance_enu_m2(&prior.nav.p, &prior.p)
                 + gnss_covariance_enu_m2,
+            velocity_sigmas,
         }
+    }
+
+    /// Whether the GNSS velocity is beyond [`DISAGREE_SIGMA`] of the filter's: the filter
+    /// is off in velocity, as a filter that leapt is (not a GNSS that jumped).
+    fn velocity_disagrees(&self) -> bool {
+        self.velocity_sigmas.is_some_and(|s| s > DISAGREE_SIGMA)
     }
 
     /// The Mahalanobis distance of the offset (σ); None when the covariance is not
     /// positive definite.
     pub fn sigmas(&self) -> Option<f64> {
-        let chol = self.covariance_enu_m2.cholesky()?;
-        let d2 = self.offset_enu_m.dot(&chol.solve(&self.offset_enu_m));
-        d2.is_finite().then(|| d2.sqrt())
+        mahalanobis(&self.offset_enu_m, &self.covariance_enu_m2)
     }
+}
+
+/// The Mahalanobis length of `x` under `covariance` (σ); None when the covariance is not
+/// positive definite.
+fn mahalanobis(x: &Vector3<f64>, covariance: &Matrix3<f64>) -> Option<f64> {
+    let chol = covariance.cholesky()?;
+    let d2 = x.dot(&chol.solve(x));
+    d2.is_finite().then(|| d2.sqrt())
 }
 
 /// The current run of disagreeing epochs.
@@ -112,11 +141,12 @@ struct Run {
     epochs: u32,
 }
 
-/// The epoch before: its time, its offset if it was judged, and whether it disagreed.
+/// The epoch before: its time, its disagreement if it was judged, and whether it
+/// disagreed.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Previous {
     t_s: f64,
-    offset_enu_m: Option<Vector3<f64>>,
+    judged: Option<Disagreement>,
     disagreed: bool,
 }
 
@@ -139,7 +169,7 @@ impl DivergenceMonitor {
         let previous = self.previous.filter(|p| t_s - p.t_s <= MAX_EPOCH_GAP_S);
         self.previous = Some(Previous {
             t_s,
-            offset_enu_m: judged.map(|(d, _)| d.offset_enu_m),
+            judged: judged.map(|(d, _)| *d),
             disagreed: disagreeing.is_some(),
         });
         let Some(d) = disagreeing else {
@@ -148,16 +178,17 @@ impl DivergenceMonitor {
             return false;
         };
         if let Some(Previous {
-            offset_enu_m: Some(before),
+            judged: Some(before),
             disagreed: false,
             ..
         }) = previous
         {
             let step = Disagreement {
-                offset_enu_m: d.offset_enu_m - before,
+                offset_enu_m: d.offset_enu_m - before.offset_enu_m,
                 ..*d
             };
-            self.gnss_jumped |= step.sigmas().is_some_and(|s| s > DISAGREE_SIGMA);
+            let leapt = step.sigmas().is_some_and(|s| s > DISAGREE_SIGMA);
+            self.gnss_jumped |= leapt && !d.velocity_disagrees();
         }
         if self.gnss_jumped {
             self.run = None;
@@ -195,11 +226,13 @@ impl DivergenceMonitor {
 mod tests {
     use super::*;
 
+    /// The GNSS `east_m` east of the filter (1 m σ), with no GNSS velocity.
     fn epoch(t_s: f64, east_m: f64) -> Disagreement {
         Disagreement {
             t_s,
             offset_enu_m: Vector3::new(east_m, 0.0, 0.0),
             covariance_enu_m2: Matrix3::identity(),
+            velocity_sigmas: None,
         }
     }
 
@@ -223,6 +256,35 @@ mod tests {
             .map(|(k, east_m)| check(&mut monitor, k as f64, east_m))
             .collect();
         assert_eq!(verdicts, [false, false, false, false, false, true]);
+    }
+
+    #[test]
+    fn a_filter_that_leaps_while_the_gnss_goes_on_is_divergence() {
+        let mut monitor = DivergenceMonitor::default();
+        // The filter agrees, then leaps 20 m (as when the GNSS jumps) with a velocity 50σ
+        // off the GNSS's.
+        let verdicts: Vec<bool> = (0..6)
+            .map(|k| {
+                let t_s = f64::from(k);
+                let (east_m, velocity_sigmas) = if k == 0 { (0.5, 0.1) } else { (20.0, 50.0) };
+                let d = Disagreement {
+                    velocity_sigmas: Some(velocity_sigmas),
+                    ..epoch(t_s, east_m)
+                };
+                monitor.check(t_s, Some(&d))
+            })
+            .collect();
+        assert_eq!(verdicts, [false, false, false, false, true, true]);
+        // The same leap with the velocities agreeing is the GNSS's: no divergence.
+        let mut monitor = DivergenceMonitor::default();
+        for k in 0..6 {
+            let t_s = f64::from(k);
+            let d = Disagreement {
+                velocity_sigmas: Some(1.0),
+                ..epoch(t_s, if k == 0 { 0.5 } else { 20.0 })
+            };
+            assert!(!monitor.check(t_s, Some(&d)));
+        }
     }
 
     #[test]

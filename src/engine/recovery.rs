@@ -4,7 +4,7 @@
 
 use nalgebra::Matrix3;
 
-use super::divergence::Disagreement;
+use super::divergence::{Disagreement, GnssVelocityEnu};
 use super::filter_state::FilterState;
 use super::output::{EpochReport, SatRejection};
 use super::update::{position_covariance, sigma_model};
@@ -33,12 +33,22 @@ impl Engine {
         report: &EpochReport,
     ) -> Option<Output> {
         let gnss = match m {
-            Measurement::Fix(f) => Some((f.position, position_covariance(f, &self.config))),
+            Measurement::Fix(f) => Some(IndependentGnss {
+                position: f.position,
+                covariance_enu_m2: position_covariance(f, &self.config),
+                velocity: f.velocity_enu_mps.zip(f.velocity_covariance_enu_m2_s2),
+            }),
             Measurement::Gnss(e) => single_point_if_gated(e, report, prior, &self.config),
             Measurement::WheelSpeed(_) => None,
         };
-        let disagreement = gnss.map(|(position, covariance_enu_m2)| {
-            Disagreement::of(prior, &position, &covariance_enu_m2, &self.config)
+        let disagreement = gnss.map(|g| {
+            Disagreement::of(
+                prior,
+                &g.position,
+                &g.covariance_enu_m2,
+                g.velocity.as_ref(),
+                &self.config,
+            )
         });
         if !self.monitor.check(report.t_s, disagreement.as_ref()) {
             return None;
@@ -56,15 +66,22 @@ impl Engine {
     }
 }
 
-/// The single-point solution of `epoch` (position and its ENU covariance) when the gate
-/// refused at least [`SPP_ABOVE_GATED_SHARE`] of its judged pseudo-ranges; None otherwise
-/// or when it has no solution with `init.min_satellites`.
+/// A GNSS position independent of the filter, and its velocity when there is one.
+struct IndependentGnss {
+    position: Llh,
+    covariance_enu_m2: Matrix3<f64>,
+    velocity: Option<GnssVelocityEnu>,
+}
+
+/// The single-point solution of `epoch` (position, velocity and their ENU covariances)
+/// when the gate refused at least [`SPP_ABOVE_GATED_SHARE`] of its judged pseudo-ranges;
+/// None otherwise or when it has no solution with `init.min_satellites`.
 fn single_point_if_gated(
     epoch: &GnssEpoch,
     report: &EpochReport,
     prior: &FilterState,
     config: &Config,
-) -> Option<(Llh, Matrix3<f64>)> {
+) -> Option<IndependentGnss> {
     let gated = |r: &Option<SatRejection>| {
         matches!(
             r,
@@ -96,6 +113,14 @@ fn single_point_if_gated(
         return None;
     }
     let rot = earth::rot_ecef_to_enu(&sol.pos_llh);
-    let cov_ecef: Matrix3<f64> = sol.covariance.fixed_view::<3, 3>(0, 0).into();
-    Some((sol.pos_llh, rot * cov_ecef * rot.transpose()))
+    let to_enu = |cov_ecef: Matrix3<f64>| rot * cov_ecef * rot.transpose();
+    let velocity = sol.velocity.as_ref().ok().map(|v| {
+        let cov_ecef: Matrix3<f64> = v.covariance.fixed_view::<3, 3>(0, 0).into();
+        (v.vel_enu_mps, to_enu(cov_ecef))
+    });
+    Some(IndependentGnss {
+        position: sol.pos_llh,
+        covariance_enu_m2: to_enu(sol.covariance.fixed_view::<3, 3>(0, 0).into()),
+        velocity,
+    })
 }
