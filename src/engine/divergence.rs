@@ -25,9 +25,10 @@
 //!   the receiver's) is beyond [`DISAGREE_SIGMA`] of the filter's: an IMU fault the
 //!   screening lets through (a burst of 4 g for half a second) makes the filter leap
 //!   within a second, and it gets there with a velocity error, while a position jump of
-//!   the GNSS (a reflection) leaves its Doppler velocity alone. A GNSS leap (fixes biased by NLOS reception in a street canyon,
-//!   confidently wrong for a hundred seconds in tests/consumer_mems_drive.rs) starts no
-//!   run until an epoch agrees again; a filter that drifts crosses 5σ in small steps.
+//!   the GNSS (a reflection) leaves its Doppler velocity alone. A GNSS leap (fixes
+//!   biased by NLOS reception in a street canyon, confidently wrong for a hundred seconds
+//!   in tests/consumer_mems_drive.rs) starts no run until an epoch agrees again; a filter
+//!   that drifts crosses 5σ in small steps.
 //!   After an outage there is no epoch before to compare with, and the drift of the
 //!   outage is judged as above.
 //!
