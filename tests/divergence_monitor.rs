@@ -281,7 +281,7 @@ fn position_sigma_3d_m(state: &FilterState) -> f64 {
     cov.trace().max(0.0).sqrt()
 }
 
-/// A consumer-MEMS gyro whose biases jump to ten times their value (1–4 °/s, far beyond
+/// A consumer-MEMS gyro whose biases jump to ten times their value (0.6–1.1 °/s, far beyond
 /// the class's σ of 500 °/h) at 60 s, tightly coupled: the position runs off within
 /// seconds; the monitor resets within 5 s of the first epoch beyond 5σ, and the restarted
 /// filter (aligned again, with a wide gyro bias prior) is within 3σ from 60 s after its
