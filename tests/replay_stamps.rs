@@ -24,7 +24,7 @@ use adaptive_gnss_ins::ros::msg::{
 use adaptive_gnss_ins::ros::outbound::service_of;
 use adaptive_gnss_ins::sim::{Scenario, ScenarioSpec};
 use adaptive_gnss_ins::tools::replay::{replay, ReplayOptions, TruthSource};
-use adaptive_gnss_ins::tools::simulate::{simulate, GNSS_TOPIC, IMU_TOPIC};
+use adaptive_gnss_ins::tools::simulate::{simulate, time_base, GNSS_TOPIC, IMU_TOPIC};
 
 const NS_PER_S: u64 = 1_000_000_000;
 /// 2020-01-01 00:00:00 UTC, in unix seconds: where this decade begins.
@@ -211,6 +211,15 @@ fn a_simulated_bag_is_stamped_in_gps_time_and_replays_to_the_nanosecond() {
     assert_eq!(imu_stamps[1].nanosec % 10_000_000, 2_500_001);
     assert!(imu_stamps.iter().all(|t| t.nanosec % 2 == 1));
     assert_eq!(scenario.clock().scenario_time_s(&imu_stamps[1]), 0.0025);
+    // What `simulate` says of it: 2025-10-02 02:59:51 UTC (week 2386 began on Sunday
+    // 2025-09-28; the constellation's Thursday 00:00:09 GPST plus 3 h, less 18 s).
+    let said = time_base(&scenario);
+    assert!(
+        said.contains(
+            "1759373991.000000001 s since 1970, GPS week 2386 time of week 356409.000000001 s"
+        ),
+        "{said}"
+    );
 
     let out = dir.path().join("out.mcap");
     let options = ReplayOptions {

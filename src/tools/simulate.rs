@@ -28,6 +28,7 @@ use nalgebra::Vector3;
 
 use crate::earth::Llh;
 use crate::engine::Solution;
+use crate::gnss::time_scale::DEFAULT_GPS_UTC_LEAP_S;
 use crate::ins::error_state::StateMatrix;
 use crate::ros::bag::{BagError, BagWriter};
 use crate::ros::msg::{
@@ -35,6 +36,7 @@ use crate::ros::msg::{
     NoiseEstimates, Odometry, SatelliteNoise, TwistWithCovarianceStamped,
 };
 use crate::ros::outbound;
+use crate::sim::constellation::GpsConstellation;
 use crate::sim::scenario::{Scenario, SimEvent};
 use crate::sim::{ScenarioClock, ScenarioError};
 
@@ -84,6 +86,22 @@ fn stamp(clock: &ScenarioClock, t_s: f64) -> Result<(crate::ros::msg::Time, u64)
     let stamp = clock.stamp(t_s).ok_or_else(error)?;
     let log_time_ns = u64::try_from(clock.utc_ns(t_s)).map_err(|_| error())?;
     Ok((stamp, log_time_ns))
+}
+
+/// The time base of `scenario`'s bag in words: the UTC stamp of scenario time 0 and its
+/// GPS week and time of week.
+pub fn time_base(scenario: &Scenario) -> String {
+    let clock = scenario.clock();
+    let start_ns = clock.start_utc_ns();
+    format!(
+        "stamps and log times are UTC (ROS time): scenario time 0 is {}.{:09} s since 1970, \
+         GPS week {} time of week {:.9} s (GPS - UTC = {} s)",
+        start_ns.div_euclid(1_000_000_000),
+        start_ns.rem_euclid(1_000_000_000),
+        clock.gps_week(0.0),
+        GpsConstellation::gps_time_of_week_s(scenario.gps_time_s(0.0)),
+        DEFAULT_GPS_UTC_LEAP_S
+    )
 }
 
 /// Writes `scenario` to the bag at `out` with the default topics.
