@@ -83,28 +83,26 @@ fn restamped_fixture(out: &Path) -> (HashSet<Time>, HashSet<Time>) {
     (imu_stamps, epoch_stamps)
 }
 
-#[test]
-fn replay_outputs_carry_their_inputs_stamps_to_the_nanosecond() {
-    let dir = tempfile::tempdir().unwrap();
-    let bag = dir.path().join("2025.mcap");
-    let (imu_stamps, epoch_stamps) = restamped_fixture(&bag);
-    let out = dir.path().join("out.mcap");
+/// Replays `bag` with the default parameters and /tf into the bag `out`.
+fn replay_with_tf(bag: &Path, out: &Path) {
     let options = ReplayOptions {
-        out_bag: Some(&out),
+        out_bag: Some(out),
         frames: OutputFrames {
             publish_tf: true,
             ..OutputFrames::default()
         },
         ..ReplayOptions::default()
     };
-    replay(
-        &bag,
-        &Config::default(),
-        TruthSource::None,
-        &options,
-        |_| {},
-    )
-    .unwrap();
+    replay(bag, &Config::default(), TruthSource::None, &options, |_| {}).unwrap();
+}
+
+#[test]
+fn replay_outputs_carry_their_inputs_stamps_to_the_nanosecond() {
+    let dir = tempfile::tempdir().unwrap();
+    let bag = dir.path().join("2025.mcap");
+    let (imu_stamps, epoch_stamps) = restamped_fixture(&bag);
+    let out = dir.path().join("out.mcap");
+    replay_with_tf(&bag, &out);
     let mut counts = std::collections::HashMap::<String, usize>::new();
     // The NavSatFix service bits, and those of every constellation an update used.
     let (mut services, mut used_service) = (HashSet::new(), 0);
@@ -222,18 +220,7 @@ fn a_simulated_bag_is_stamped_in_gps_time_and_replays_to_the_nanosecond() {
     );
 
     let out = dir.path().join("out.mcap");
-    let options = ReplayOptions {
-        out_bag: Some(&out),
-        ..ReplayOptions::default()
-    };
-    replay(
-        &bag,
-        &Config::default(),
-        TruthSource::None,
-        &options,
-        |_| {},
-    )
-    .unwrap();
+    replay_with_tf(&bag, &out);
     let odometry: Vec<Time> = BagReader::open(&out)
         .unwrap()
         .messages()

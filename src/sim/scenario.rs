@@ -4,8 +4,9 @@
 //!
 //! Time: scenario time t starts at 0 with the trajectory; the GNSS epochs carry t as
 //! `t_s` and the GPS time of week of `gnss.start_gps_s + t` in the constellation's
-//! convention. Where t lies in real time (stamps, GPS week) is the [`ScenarioClock`]'s. The epochs are taken at true GPS time (the receiver clock bias appears in
-//! the pseudo-ranges, not in the time tags).
+//! convention; where t lies in real time (stamps, GPS week) is the [`ScenarioClock`]'s.
+//! The epochs are taken at true GPS time (the receiver clock bias appears in the
+//! pseudo-ranges, not in the time tags).
 //!
 //! Order of events at equal times: Imu, Truth, Environment, Gnss, Fix — so a consumer has
 //! the IMU up to an epoch before the epoch itself.

@@ -69,14 +69,16 @@ impl ScenarioClock {
 
     /// Scenario time (s) of a ROS stamp: the inverse of [`Self::stamp`], exactly for the
     /// stamps it gave (the difference is taken in nanoseconds, then made seconds as
-    /// [`time_to_seconds`] does).
+    /// [`time_to_seconds`] does); NaN for an invalid stamp or one 68 years away.
     pub fn scenario_time_s(&self, stamp: &Time) -> f64 {
         let ns = i64::from(stamp.sec) * NS_PER_S + i64::from(stamp.nanosec) - self.start_utc_ns;
-        let relative = Time {
-            sec: ns.div_euclid(NS_PER_S) as i32,
-            nanosec: ns.rem_euclid(NS_PER_S) as u32,
+        let (Ok(sec), Ok(nanosec)) = (
+            i32::try_from(ns.div_euclid(NS_PER_S)),
+            u32::try_from(ns.rem_euclid(NS_PER_S)),
+        ) else {
+            return f64::NAN;
         };
-        time_to_seconds(&relative).unwrap_or(f64::NAN)
+        time_to_seconds(&Time { sec, nanosec }).unwrap_or(f64::NAN)
     }
 
     /// Scenario time (s) of a time in UNIX seconds as the engine holds a stamp (`f64`
