@@ -208,7 +208,8 @@ fn a_simulated_bag_is_stamped_in_gps_time_and_replays_to_the_nanosecond() {
     assert!(first >= SEC_2020 * NS_PER_S, "{:?}", imu_stamps[0]);
     assert_eq!(imu_stamps[1].nanosec % 10_000_000, 2_500_001);
     assert!(imu_stamps.iter().all(|t| t.nanosec % 2 == 1));
-    assert_eq!(scenario.clock().scenario_time_s(&imu_stamps[1]), 0.0025);
+    let second_ns = i64::try_from(total_ns(&imu_stamps[1])).unwrap();
+    assert_eq!(scenario.clock().scenario_time_of_utc_ns(second_ns), 0.0025);
     // What `simulate` says of it: 2025-10-02 02:59:51 UTC (week 2386 began on Sunday
     // 2025-09-28; the constellation's Thursday 00:00:09 GPST plus 3 h, less 18 s).
     let said = time_base(&scenario);

@@ -14,21 +14,20 @@
 //! spec accepts).
 
 use crate::gnss::time_scale::{DEFAULT_GPS_UTC_LEAP_S, GPS_EPOCH_SINCE_1970_S, SECONDS_PER_WEEK};
-use crate::ros::convert::{seconds_to_time, time_to_seconds};
-use crate::ros::msg::Time;
 use crate::sim::constellation::REFERENCE_EPOCH_GPS_TOW_S;
 use crate::sim::scenario_spec::GnssSpec;
 
 const NS_PER_S: i64 = 1_000_000_000;
 
-/// The real time of a scenario's time line.
+/// The real time of a scenario's time line. Real times are whole nanoseconds since
+/// 1970-01-01 in UTC, what a ROS stamp holds (the ROS layer makes them stamps).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ScenarioClock {
     /// GPS week of the constellation's reference epoch.
     reference_week: u16,
     /// GPS time of scenario time 0 after the constellation's reference epoch (s).
     start_gps_s: f64,
-    /// UTC (ROS stamp) of scenario time 0, ns since 1970-01-01.
+    /// UTC of scenario time 0, ns since 1970-01-01.
     start_utc_ns: i64,
 }
 
@@ -44,7 +43,7 @@ impl ScenarioClock {
         Self {
             reference_week: gnss.constellation_gps_week,
             start_gps_s: gnss.start_gps_s,
-            start_utc_ns: whole_utc_s * NS_PER_S + relative_ns(gnss.start_gps_s),
+            start_utc_ns: whole_utc_s * NS_PER_S + nearest_ns(gnss.start_gps_s),
         }
     }
 
@@ -53,32 +52,18 @@ impl ScenarioClock {
         self.start_utc_ns
     }
 
-    /// UTC ns since 1970 of scenario time `t_s` (the nearest nanosecond of `t_s`).
+    /// UTC (ns since 1970-01-01) of scenario time `t_s`, to the nearest nanosecond of
+    /// `t_s`: the stamp of an event at `t_s`.
     pub fn utc_ns(&self, t_s: f64) -> i64 {
-        self.start_utc_ns + relative_ns(t_s)
+        self.start_utc_ns + nearest_ns(t_s)
     }
 
-    /// The ROS stamp (UTC) of scenario time `t_s`; None outside the range of a stamp.
-    pub fn stamp(&self, t_s: f64) -> Option<Time> {
-        let ns = self.utc_ns(t_s);
-        Some(Time {
-            sec: i32::try_from(ns.div_euclid(NS_PER_S)).ok()?,
-            nanosec: u32::try_from(ns.rem_euclid(NS_PER_S)).ok()?,
-        })
-    }
-
-    /// Scenario time (s) of a ROS stamp: the inverse of [`Self::stamp`], exactly for the
-    /// stamps it gave (the difference is taken in nanoseconds, then made seconds as
-    /// [`time_to_seconds`] does); NaN for an invalid stamp or one 68 years away.
-    pub fn scenario_time_s(&self, stamp: &Time) -> f64 {
-        let ns = i64::from(stamp.sec) * NS_PER_S + i64::from(stamp.nanosec) - self.start_utc_ns;
-        let (Ok(sec), Ok(nanosec)) = (
-            i32::try_from(ns.div_euclid(NS_PER_S)),
-            u32::try_from(ns.rem_euclid(NS_PER_S)),
-        ) else {
-            return f64::NAN;
-        };
-        time_to_seconds(&Time { sec, nanosec }).unwrap_or(f64::NAN)
+    /// Scenario time (s) of a UTC time in ns since 1970 (a stamp): the inverse of
+    /// [`Self::utc_ns`], exactly for the times it gave (the difference is taken in
+    /// nanoseconds, then made `whole + nanoseconds / 1e9` seconds, as a ROS stamp is read).
+    pub fn scenario_time_of_utc_ns(&self, utc_ns: i64) -> f64 {
+        let ns = utc_ns - self.start_utc_ns;
+        ns.div_euclid(NS_PER_S) as f64 + ns.rem_euclid(NS_PER_S) as f64 / NS_PER_S as f64
     }
 
     /// Scenario time (s) of a time in UNIX seconds as the engine holds a stamp (`f64`
@@ -101,10 +86,12 @@ impl ScenarioClock {
     }
 }
 
-/// Nanoseconds of `t_s` seconds (the nearest, as [`seconds_to_time`] rounds; 0 for a time
-/// no stamp can hold, which validation excludes).
-fn relative_ns(t_s: f64) -> i64 {
-    seconds_to_time(t_s).map_or(0, |t| i64::from(t.sec) * NS_PER_S + i64::from(t.nanosec))
+/// The nearest whole nanoseconds of `t_s` seconds: the whole seconds split off first (the
+/// fraction is then exact) and only the fraction rounded, as a ROS stamp is made. Times
+/// are those of a validated scenario, far inside an `i64`.
+fn nearest_ns(t_s: f64) -> i64 {
+    let whole_s = t_s.floor();
+    whole_s as i64 * NS_PER_S + ((t_s - whole_s) * NS_PER_S as f64).round() as i64
 }
 
 #[cfg(test)]
@@ -138,26 +125,24 @@ mod tests {
         // An odd nanosecond in the start and an IMU time of x.0025 s.
         let clock = ScenarioClock::new(&gnss(2386, 10_800.000_000_001));
         let t_s = 1234.0025;
-        let stamp = clock.stamp(t_s).unwrap();
-        assert_eq!(stamp.nanosec % 10_000_000, 2_500_001);
-        assert_eq!(clock.scenario_time_s(&stamp), t_s);
+        let utc_ns = clock.utc_ns(t_s);
+        let (sec, nanosec) = (utc_ns.div_euclid(NS_PER_S), utc_ns.rem_euclid(NS_PER_S));
+        assert_eq!(nanosec % 10_000_000, 2_500_001);
+        assert_eq!(clock.scenario_time_of_utc_ns(utc_ns), t_s);
         let gps_s = 10_800.000_000_001 + t_s;
         let tow_s = GpsConstellation::gps_time_of_week_s(gps_s);
-        let gpst_s = f64::from(stamp.sec) + DEFAULT_GPS_UTC_LEAP_S;
+        let gpst_s = sec as f64 + DEFAULT_GPS_UTC_LEAP_S;
         let (week, whole_tow_s) = week_tow_of_gpst(gpst_s).unwrap();
         assert_eq!(week, clock.gps_week(t_s));
         let tow_ns = (tow_s * 1e9).round() as i64;
-        assert_eq!(
-            tow_ns,
-            whole_tow_s as i64 * NS_PER_S + i64::from(stamp.nanosec)
-        );
+        assert_eq!(tow_ns, whole_tow_s as i64 * NS_PER_S + nanosec);
     }
 
     #[test]
     fn unix_seconds_map_back_to_the_nearest_scenario_time() {
         let clock = ScenarioClock::new(&gnss(2386, 10_800.0));
-        let stamp = clock.stamp(145.0).unwrap();
-        let unix_s = time_to_seconds(&stamp).unwrap();
+        let utc_ns = clock.utc_ns(145.0);
+        let unix_s = utc_ns as f64 / NS_PER_S as f64;
         let t_s = clock.scenario_time_of_unix_s(unix_s);
         assert!((t_s - 145.0).abs() < 2.4e-7, "{t_s}");
     }

@@ -40,6 +40,8 @@ use crate::sim::constellation::GpsConstellation;
 use crate::sim::scenario::{Scenario, SimEvent};
 use crate::sim::{ScenarioClock, ScenarioError};
 
+const NS_PER_S: i64 = 1_000_000_000;
+
 /// Topic names of simulated bags (and the defaults of `replay`).
 pub const IMU_TOPIC: &str = "/imu";
 pub const GNSS_TOPIC: &str = "/gnss/measurements";
@@ -83,8 +85,12 @@ pub struct SimulateOptions {
 /// The stamp and the log time (the same instant) of scenario time `t_s`.
 fn stamp(clock: &ScenarioClock, t_s: f64) -> Result<(crate::ros::msg::Time, u64), SimulateError> {
     let error = || SimulateError::Time { t_s };
-    let stamp = clock.stamp(t_s).ok_or_else(error)?;
-    let log_time_ns = u64::try_from(clock.utc_ns(t_s)).map_err(|_| error())?;
+    let ns = clock.utc_ns(t_s);
+    let stamp = crate::ros::msg::Time {
+        sec: i32::try_from(ns.div_euclid(NS_PER_S)).map_err(|_| error())?,
+        nanosec: u32::try_from(ns.rem_euclid(NS_PER_S)).map_err(|_| error())?,
+    };
+    let log_time_ns = u64::try_from(ns).map_err(|_| error())?;
     Ok((stamp, log_time_ns))
 }
 
@@ -96,8 +102,8 @@ pub fn time_base(scenario: &Scenario) -> String {
     format!(
         "stamps and log times are UTC (ROS time): scenario time 0 is {}.{:09} s since 1970, \
          GPS week {} time of week {:.9} s (GPS - UTC = {} s)",
-        start_ns.div_euclid(1_000_000_000),
-        start_ns.rem_euclid(1_000_000_000),
+        start_ns.div_euclid(NS_PER_S),
+        start_ns.rem_euclid(NS_PER_S),
         clock.gps_week(0.0),
         GpsConstellation::gps_time_of_week_s(scenario.gps_time_s(0.0)),
         DEFAULT_GPS_UTC_LEAP_S
