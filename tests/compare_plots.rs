@@ -36,7 +36,14 @@ fn compare_writes_png_and_svg_figures_with_every_filter() {
         assert_eq!((width, height), (1400, 1000), "{stem}");
         let svg = std::fs::read_to_string(plots.join(format!("{stem}.svg"))).unwrap();
         assert!(svg.starts_with("<svg"), "{stem}");
-        for label in ["time (s)", "ekf", "ermakf"] {
+        // The fixture is stamped in UTC (October 2025): its time axis counts from a
+        // whole second named in UTC.
+        assert!(
+            svg.lines()
+                .any(|l| l.starts_with("time since 2025-10-02 ") && l.ends_with(" UTC (s)")),
+            "{stem}: no UTC time axis"
+        );
+        for label in ["ekf", "ermakf"] {
             // The SVG backend writes each text on a line of its own.
             assert!(
                 svg.contains(&format!("\n{label}\n")),

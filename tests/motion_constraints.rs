@@ -22,8 +22,8 @@ use adaptive_gnss_ins::tools::compare::{compare_bag, NamedConfig};
 use adaptive_gnss_ins::tools::simulate::{simulate_with, SimulateOptions, TRUTH_TOPIC};
 
 use car_outage_support::{
-    at, at_outage_end_m, consumer_mems_loose, outage_distance_m, spec, CAR_OUTAGE,
-    MAX_ERROR_FRACTION, SEED,
+    at, at_outage_end_m, consumer_mems_loose, in_scenario_time, outage_distance_m, spec,
+    CAR_OUTAGE, MAX_ERROR_FRACTION, SEED,
 };
 
 /// When the parked car's GNSS goes (tests/data/consumer_mems_parked.yaml), 5 s after it
@@ -35,7 +35,7 @@ const PARKED_MAX_HEADING_DRIFT_DEG: f64 = 1.0;
 
 /// The solution errors of each configuration on the scenario `spec`.
 fn replay(spec: ScenarioSpec, configs: &[(&str, Config)]) -> Vec<Vec<SolutionError>> {
-    let scenario = Scenario::new(spec, SEED).unwrap();
+    let scenario = Scenario::new(spec.clone(), SEED).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let bag = dir.path().join("drive.mcap");
     simulate_with(&scenario, &bag, SimulateOptions { velocity: true }).unwrap();
@@ -49,7 +49,10 @@ fn replay(spec: ScenarioSpec, configs: &[(&str, Config)]) -> Vec<Vec<SolutionErr
     compare_bag(&bag, &named, TRUTH_TOPIC)
         .unwrap()
         .into_iter()
-        .map(|(_, report)| report.errors.into_iter().map(|(_, e)| e).collect())
+        .map(|(_, report)| {
+            let errors: Vec<SolutionError> = report.errors.into_iter().map(|(_, e)| e).collect();
+            in_scenario_time(&spec, &errors)
+        })
         .collect()
 }
 

@@ -390,7 +390,8 @@ fn node_joining_a_drive_in_its_middle_converges_to_the_truth() {
             .map(|o| (stamp_ns(&o), o))
             .collect();
     let live = decoded::<Odometry>(&recorded, "/odometry");
-    let join_ns = (JOIN_AT_S.parse::<f64>().unwrap() * 1e9) as i64;
+    // The player's offset counts from the bag's start, the scenario's.
+    let join_ns = scenario.clock().utc_ns(JOIN_AT_S.parse::<f64>().unwrap());
     let first_ns = stamp_ns(live.first().expect("the node published no Odometry"));
     assert!(
         first_ns >= join_ns,

@@ -44,6 +44,12 @@ fn fixture_bag() -> PathBuf {
     data("fixture_small.mcap")
 }
 
+/// The fixture's scenario with its seed.
+fn fixture_scenario() -> Scenario {
+    let yaml = std::fs::read_to_string(data("fixture_small.yaml")).unwrap();
+    Scenario::new(ScenarioSpec::from_yaml(&yaml).unwrap(), FIXTURE_SEED).unwrap()
+}
+
 fn golden_csv() -> PathBuf {
     data("fixture_small_solution.csv")
 }
@@ -117,19 +123,27 @@ fn rosbags_reads_the_fixture_as_a_ros2_bag() {
         total += count;
     }
     assert_eq!(summary["message_count"], total);
-    assert_eq!(summary["start_time_ns"], 0);
+    // Log times are UTC, from the scenario's start (the default week: 2025-10-01
+    // 23:59:51 UTC, plus the scenario's start_gps_s of 3 h).
+    let start_ns = fixture_scenario().clock().start_utc_ns();
+    assert_eq!(start_ns, 1_759_363_191_000_000_000 + 10_800_000_000_000);
+    assert_eq!(summary["start_time_ns"], start_ns);
     // rosbags reports the end as one past the last log time (36 s).
-    assert_eq!(summary["end_time_ns"], 36_000_000_001_u64);
+    assert_eq!(summary["end_time_ns"], start_ns + 36_000_000_001);
     for (type_name, verdict) in summary["definitions"].as_object().unwrap() {
         assert!(
             verdict == "matches jazzy" || verdict == "matches msg/",
             "{type_name}: {verdict}"
         );
     }
-    // The first IMU sample as rosbags decoded it: stamped 0, at rest (the specific force
-    // is gravity, up, with the simulated accelerometer errors).
+    // The first IMU sample as rosbags decoded it: stamped at the start, at rest (the
+    // specific force is gravity, up, with the simulated accelerometer errors).
     let first_imu = &topics["/imu"]["first"];
-    assert_eq!(first_imu["header"]["stamp"]["sec"], 0);
+    assert_eq!(
+        first_imu["header"]["stamp"]["sec"],
+        start_ns / 1_000_000_000
+    );
+    assert_eq!(first_imu["header"]["stamp"]["nanosec"], 0);
     let f_up = first_imu["linear_acceleration"]["z"].as_f64().unwrap();
     assert!((f_up - 9.80).abs() < 0.05, "{f_up}");
 }
@@ -162,6 +176,8 @@ fn replaying_the_fixture_reproduces_the_golden_solution() {
     let mut worst = (0.0_f64, String::new());
     for (i, (row, want)) in rows.iter().zip(&golden).enumerate() {
         assert_eq!(row.len(), want.len(), "row {i}");
+        // The time (UNIX seconds, where the relative test would allow 1.8 s) exactly.
+        assert_eq!(row[0], want[0], "row {i}: t_s");
         for ((got, want), column) in row.iter().zip(want).zip(&columns) {
             let scale = got.abs().max(want.abs()).max(1.0);
             let error = (got - want).abs() / scale;
@@ -190,8 +206,7 @@ fn regenerate_golden_solution() {
 #[test]
 #[ignore = "regenerates tests/data/fixture_small.mcap"]
 fn regenerate_fixture_bag() {
-    let yaml = std::fs::read_to_string(data("fixture_small.yaml")).unwrap();
-    let scenario = Scenario::new(ScenarioSpec::from_yaml(&yaml).unwrap(), FIXTURE_SEED).unwrap();
+    let scenario = fixture_scenario();
     let summary = simulate(&scenario, &fixture_bag()).unwrap();
     eprintln!("wrote {}: {summary:?}", fixture_bag().display());
 }
@@ -203,8 +218,7 @@ fn simulating_the_fixture_scenario_again_gives_the_same_bytes() {
     let yaml = std::fs::read_to_string(data("fixture_small.yaml")).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let again = dir.path().join("again.mcap");
-    let scenario = Scenario::new(ScenarioSpec::from_yaml(&yaml).unwrap(), FIXTURE_SEED).unwrap();
-    simulate(&scenario, &again).unwrap();
+    simulate(&fixture_scenario(), &again).unwrap();
     let committed = std::fs::read(fixture_bag()).unwrap();
     assert!(
         std::fs::read(&again).unwrap() == committed,

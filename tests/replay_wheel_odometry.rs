@@ -29,8 +29,8 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 
 use car_outage_support::{
-    at_outage_end_m, consumer_mems_loose, outage_distance_m, spec, CAR_OUTAGE, MAX_ERROR_FRACTION,
-    SEED,
+    at_outage_end_m, consumer_mems_loose, in_scenario_time, outage_distance_m, spec, CAR_OUTAGE,
+    MAX_ERROR_FRACTION, SEED,
 };
 
 const WHEEL_SIGMA_MPS: f64 = 0.05;
@@ -86,7 +86,7 @@ fn replay_scored(bag: &Path, config: &Config) -> BagRun {
 /// The horizontal error of `run` scored nearest to the outage's end.
 fn run_at_outage_end_m(run: &BagRun) -> f64 {
     let errors: Vec<SolutionError> = run.report.errors.iter().map(|(_, e)| *e).collect();
-    at_outage_end_m(&errors)
+    at_outage_end_m(&in_scenario_time(&spec(CAR_OUTAGE), &errors))
 }
 
 #[test]

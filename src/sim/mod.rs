@@ -12,6 +12,7 @@ pub mod imu_errors;
 pub mod receiver_clock;
 pub mod sat_errors;
 pub mod scenario;
+pub mod scenario_clock;
 pub mod scenario_error;
 pub mod scenario_spec;
 pub mod smooth_window;
@@ -19,6 +20,7 @@ pub mod trajectory;
 
 pub use imu_errors::{ImuErrorModel, ImuErrorModelError, ImuErrorSpec};
 pub use scenario::{GnssTruth, Scenario, ScenarioEvents, SimEvent};
+pub use scenario_clock::ScenarioClock;
 pub use scenario_error::ScenarioError;
 pub use scenario_spec::ScenarioSpec;
 pub use trajectory::{Segment, Trajectory, TrajectoryError, TrajectorySpec, TruthSample};

@@ -4,8 +4,9 @@
 //!
 //! Time: scenario time t starts at 0 with the trajectory; the GNSS epochs carry t as
 //! `t_s` and the GPS time of week of `gnss.start_gps_s + t` in the constellation's
-//! convention. The epochs are taken at true GPS time (the receiver clock bias appears in
-//! the pseudo-ranges, not in the time tags).
+//! convention; where t lies in real time (stamps, GPS week) is the [`ScenarioClock`]'s.
+//! The epochs are taken at true GPS time (the receiver clock bias appears in the
+//! pseudo-ranges, not in the time tags).
 //!
 //! Order of events at equal times: Imu, Truth, Environment, Gnss, Fix — so a consumer has
 //! the IMU up to an epoch before the epoch itself.
@@ -30,6 +31,7 @@ use crate::sim::receiver_clock::{ReceiverClock, ReceiverClockState};
 use crate::sim::sat_errors::{
     stream_rng, FoliageModels, SatContext, SatErrorGenerator, SatErrorTruth, StreamPurpose,
 };
+use crate::sim::scenario_clock::ScenarioClock;
 use crate::sim::scenario_error::ScenarioError;
 use crate::sim::scenario_spec::ScenarioSpec;
 use crate::sim::{ImuErrorModel, Trajectory, TruthSample};
@@ -216,6 +218,11 @@ impl Scenario {
     /// GPS time (s since the constellation's reference epoch) of scenario time `t_s`.
     pub fn gps_time_s(&self, t_s: f64) -> f64 {
         self.spec.gnss.start_gps_s + t_s
+    }
+
+    /// Where the scenario lies in real time: stamps and GPS weeks of scenario times.
+    pub fn clock(&self) -> ScenarioClock {
+        ScenarioClock::new(&self.spec.gnss)
     }
 
     /// The environment at scenario time `t_s` and its segment index.

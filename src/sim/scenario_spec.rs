@@ -38,6 +38,19 @@ fn default_truth_rate_hz() -> f64 {
     10.0
 }
 
+/// Choice: GPS week 2386, so that a scenario starts on 2025-10-01 23:59:51 UTC plus its
+/// `start_gps_s` (a recent date: stamps of this decade, which `f64` seconds resolve only to
+/// 238 ns, as a real recording's are).
+pub const DEFAULT_CONSTELLATION_GPS_WEEK: u16 = 2386;
+/// The GPS weeks accepted for the constellation: from 2017-01-01 (week 1930), since when
+/// GPS − UTC has been the 18 s the stamps assume, to week 3000 (2037-07), inside the
+/// range of a ROS stamp's seconds.
+pub const CONSTELLATION_GPS_WEEKS: std::ops::RangeInclusive<u16> = 1930..=3000;
+
+fn default_constellation_gps_week() -> u16 {
+    DEFAULT_CONSTELLATION_GPS_WEEK
+}
+
 fn default_extra_satellites_per_plane() -> usize {
     1
 }
@@ -175,9 +188,16 @@ pub struct GnssSpec {
     #[serde(default = "default_gnss_rate_hz")]
     pub rate_hz: f64,
     /// GPS time at scenario time 0, seconds since the constellation's reference epoch
-    /// (1993-07-01 00:00 UTC); sets the satellite geometry and the local time. Default 0.
+    /// (its slot table's 1993-07-01 00:00 UTC, placed in `constellation_gps_week`), in
+    /// [0, 1e9); sets the satellite geometry and the local time. Default 0.
     #[serde(default)]
     pub start_gps_s: f64,
+    /// GPS week in which the constellation's reference epoch is placed (its Thursday
+    /// 00:00:09 GPS time; see [`crate::sim::scenario_clock`]): with `start_gps_s` it sets
+    /// the real date of the scenario, its stamps (UTC) and the week of its GNSS epochs.
+    /// In [1930, 3000]. Default [`DEFAULT_CONSTELLATION_GPS_WEEK`].
+    #[serde(default = "default_constellation_gps_week")]
+    pub constellation_gps_week: u16,
     /// Satellites added to each of the six orbit planes of the baseline 24 (default 1:
     /// 30 satellites, like today's GPS), at most 4.
     #[serde(default = "default_extra_satellites_per_plane")]
@@ -204,6 +224,7 @@ impl Default for GnssSpec {
         Self {
             rate_hz: default_gnss_rate_hz(),
             start_gps_s: 0.0,
+            constellation_gps_week: DEFAULT_CONSTELLATION_GPS_WEEK,
             extra_satellites_per_plane: default_extra_satellites_per_plane(),
             elevation_mask_deg: default_elevation_mask_deg(),
             antenna_lever_arm_m: [0.0; 3],
@@ -289,8 +310,14 @@ impl ScenarioSpec {
             return Err(invalid("truth_rate_hz", "must be in (0, 1000]"));
         }
         let g = &self.gnss;
-        if !g.start_gps_s.is_finite() {
-            return Err(invalid("gnss.start_gps_s", "must be finite"));
+        if !(0.0..1e9).contains(&g.start_gps_s) {
+            return Err(invalid("gnss.start_gps_s", "must be in [0, 1e9)"));
+        }
+        if !CONSTELLATION_GPS_WEEKS.contains(&g.constellation_gps_week) {
+            return Err(invalid(
+                "gnss.constellation_gps_week",
+                "must be in [1930, 3000] (from 2017, GPS - UTC = 18 s)",
+            ));
         }
         if g.extra_satellites_per_plane > 4 {
             return Err(invalid(

@@ -148,6 +148,7 @@ pub fn run(command: Command) -> Result<(), String> {
                 summary.velocities,
                 summary.truth
             );
+            eprintln!("{}", simulate::time_base(&scenario));
             Ok(())
         }
         Command::Replay {

@@ -384,7 +384,8 @@ fn environment_color(name: &str) -> RGBColor {
     }
 }
 
-/// Times from this on are UNIX times (1973 on); the simulator's start near 0.
+/// Times from this on are UNIX times (1973 on); below, a time line of its own (a scenario's
+/// when `compare` simulates it without a bag).
 const UNIX_TIME_FROM_S: f64 = 1e8;
 
 /// The time axis of a figure spanning `x`: the offset subtracted from every time and the

@@ -1,6 +1,12 @@
 //! `gnss_ins simulate`: a scenario written as a rosbag2 MCAP bag.
 //!
-//! Topics (stamps and log times are scenario time, starting at 0):
+//! Time base: every stamp and log time is UTC (UNIX time, as ROS stamps are), scenario
+//! time 0 at the scenario's real start ([`crate::sim::ScenarioClock`]: by default in
+//! October 2025), and the GNSS epochs' `gps_week` and `gps_time_of_week_s` name the same
+//! instant in GPS time (GPS − UTC = 18 s). [`Scenario::clock`] maps stamps back to
+//! scenario time.
+//!
+//! Topics:
 //! - `/imu` sensor_msgs/Imu (REP-145, frame `imu_link`);
 //! - `/gnss/measurements` our GnssMeasurements (frame `gnss_antenna`);
 //! - `/gnss/fix` sensor_msgs/NavSatFix, a receiver-like single-point fix (loose coupling);
@@ -10,7 +16,7 @@
 //!   just after it;
 //! - `/ground_truth` nav_msgs/Odometry of the true IMU position in the ENU frame `map`
 //!   whose origin is the trajectory's start, written in `/ground_truth/datum`
-//!   (sensor_msgs/NavSatFix, once at t = 0);
+//!   (sensor_msgs/NavSatFix, once at the start);
 //! - `/ground_truth/noise` our NoiseEstimates with the true σ² of every satellite's
 //!   pseudo-range and rate in the `r_*` fields (filter_variant "truth");
 //! - `/ground_truth/environment` diagnostic_msgs/DiagnosticArray, one status named
@@ -22,17 +28,19 @@ use nalgebra::Vector3;
 
 use crate::earth::Llh;
 use crate::engine::Solution;
+use crate::gnss::time_scale::DEFAULT_GPS_UTC_LEAP_S;
 use crate::ins::error_state::StateMatrix;
 use crate::ros::bag::{BagError, BagWriter};
-use crate::ros::convert::seconds_to_time;
 use crate::ros::msg::{
     DiagnosticArray, DiagnosticStatus, GnssMeasurements, Header, Imu, NavSatFix, NavSatStatus,
     NoiseEstimates, Odometry, SatelliteNoise, TwistWithCovarianceStamped,
 };
 use crate::ros::outbound;
-use crate::sim::constellation::REFERENCE_EPOCH_GPS_TOW_S;
+use crate::sim::constellation::GpsConstellation;
 use crate::sim::scenario::{Scenario, SimEvent};
-use crate::sim::ScenarioError;
+use crate::sim::{ScenarioClock, ScenarioError};
+
+const NS_PER_S: i64 = 1_000_000_000;
 
 /// Topic names of simulated bags (and the defaults of `replay`).
 pub const IMU_TOPIC: &str = "/imu";
@@ -51,7 +59,7 @@ pub enum SimulateError {
     Scenario(#[from] ScenarioError),
     #[error(transparent)]
     Bag(#[from] BagError),
-    #[error("time {t_s} s cannot be a ROS stamp")]
+    #[error("scenario time {t_s} s cannot be a ROS stamp or a bag's log time")]
     Time { t_s: f64 },
 }
 
@@ -74,12 +82,32 @@ pub struct SimulateOptions {
     pub velocity: bool,
 }
 
-fn stamp(t_s: f64) -> Result<crate::ros::msg::Time, SimulateError> {
-    seconds_to_time(t_s).map_err(|_| SimulateError::Time { t_s })
+/// The stamp and the log time (the same instant) of scenario time `t_s`.
+fn stamp(clock: &ScenarioClock, t_s: f64) -> Result<(crate::ros::msg::Time, u64), SimulateError> {
+    let error = || SimulateError::Time { t_s };
+    let ns = clock.utc_ns(t_s);
+    let stamp = crate::ros::msg::Time {
+        sec: i32::try_from(ns.div_euclid(NS_PER_S)).map_err(|_| error())?,
+        nanosec: u32::try_from(ns.rem_euclid(NS_PER_S)).map_err(|_| error())?,
+    };
+    let log_time_ns = u64::try_from(ns).map_err(|_| error())?;
+    Ok((stamp, log_time_ns))
 }
 
-fn log_time_ns(t_s: f64) -> u64 {
-    (t_s * 1e9).round().max(0.0) as u64
+/// The time base of `scenario`'s bag in words: the UTC stamp of scenario time 0 and its
+/// GPS week and time of week.
+pub fn time_base(scenario: &Scenario) -> String {
+    let clock = scenario.clock();
+    let start_ns = clock.start_utc_ns();
+    format!(
+        "stamps and log times are UTC (ROS time): scenario time 0 is {}.{:09} s since 1970, \
+         GPS week {} time of week {:.9} s (GPS - UTC = {} s)",
+        start_ns.div_euclid(NS_PER_S),
+        start_ns.rem_euclid(NS_PER_S),
+        clock.gps_week(0.0),
+        GpsConstellation::gps_time_of_week_s(scenario.gps_time_s(0.0)),
+        DEFAULT_GPS_UTC_LEAP_S
+    )
 }
 
 /// Writes `scenario` to the bag at `out` with the default topics.
@@ -106,11 +134,11 @@ pub fn simulate_with(
     bag.add_topic::<DiagnosticArray>(TRUTH_ENVIRONMENT_TOPIC)?;
     let mut summary = SimulateSummary::default();
     let mut datum: Option<Llh> = None;
+    let clock = scenario.clock();
     for event in scenario.events() {
         let event = event?;
         let t = event.t_s();
-        let st = stamp(t)?;
-        let ns = log_time_ns(t);
+        let (st, ns) = stamp(&clock, t)?;
         match event {
             SimEvent::Imu(s) => {
                 bag.write(IMU_TOPIC, &outbound::imu(&s, st, "imu_link"), ns)?;
@@ -142,9 +170,7 @@ pub fn simulate_with(
                 truth_sigmas,
                 ..
             } => {
-                let gps_s = REFERENCE_EPOCH_GPS_TOW_S + scenario.gps_time_s(t);
-                // The constellation's reference epoch lies in GPS week 703 (1993-07-01).
-                let week = 703 + (gps_s / 604_800.0).floor().max(0.0) as u16;
+                let week = clock.gps_week(t);
                 let msg = outbound::gnss_measurements(&epoch, week, st, "gnss_antenna");
                 bag.write(GNSS_TOPIC, &msg, ns)?;
                 bag.write(TRUTH_NOISE_TOPIC, &truth_noise(&truth_sigmas, st), ns)?;

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use adaptive_gnss_ins::config::Config;
 use adaptive_gnss_ins::eval::SolutionError;
 use adaptive_gnss_ins::ros::node::params::config_from_files;
-use adaptive_gnss_ins::sim::ScenarioSpec;
+use adaptive_gnss_ins::sim::{ScenarioClock, ScenarioSpec};
 
 pub const SEED: u64 = 1;
 /// The car's outage and its speed.
@@ -42,6 +42,19 @@ pub fn consumer_mems_loose() -> Config {
 /// The scenario of the repository file `file`.
 pub fn spec(file: &str) -> ScenarioSpec {
     ScenarioSpec::from_yaml(&std::fs::read_to_string(repo(file)).unwrap()).unwrap()
+}
+
+/// The errors of a replay of the simulated bag of `spec` (stamped in real time) on the
+/// scenario's own time line, which [`at`] and the outage constants use.
+pub fn in_scenario_time(spec: &ScenarioSpec, errors: &[SolutionError]) -> Vec<SolutionError> {
+    let clock = ScenarioClock::new(&spec.gnss);
+    errors
+        .iter()
+        .map(|e| SolutionError {
+            t_s: clock.scenario_time_of_unix_s(e.t_s),
+            ..*e
+        })
+        .collect()
 }
 
 /// The error scored nearest to `t_s`.
