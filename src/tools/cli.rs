@@ -6,7 +6,8 @@ use std::path::{Path, PathBuf};
 use clap::{Subcommand, ValueEnum};
 
 use crate::config::{Config, Coupling, FilterVariant};
-use crate::ros::adapter::{OutputFrames, TIME_JUMP_BACK_S, TIME_JUMP_CONFIRM_SAMPLES};
+use crate::ros::adapter::{TIME_JUMP_BACK_S, TIME_JUMP_CONFIRM_SAMPLES};
+use crate::ros::node::params::{node_params_from_files, NodeParams};
 use crate::ros::bag::ChunkCompression;
 use crate::sim::{Scenario, ScenarioSpec};
 
@@ -52,7 +53,9 @@ pub enum Command {
         /// params/ermakf.yaml (a later value wins). Defaults when absent.
         #[arg(long)]
         params: Vec<PathBuf>,
-        /// Output bag with /odometry, /fix/filtered and /noise_estimates.
+        /// Output bag with /odometry, /fix/filtered, /noise_estimates and, with publish_tf in
+        /// a --params file, /tf as the node publishes it (tf_mode map_to_odom reads the
+        /// base controller's odom -> base_link from the bag's /tf).
         #[arg(long)]
         out: Option<PathBuf>,
         /// zstd-compress the output bag's chunks: half the size, for about 1.5 s more CPU
@@ -159,7 +162,9 @@ pub fn run(command: Command) -> Result<(), String> {
             truth_topic,
             truth_csv,
         } => {
-            let config = load_config(&params)?;
+            // The node's own parameters too: the frames and the TF are the node's.
+            let NodeParams { config, frames, .. } =
+                node_params_from_files(&params).map_err(|e| e.to_string())?;
             let truth = match (truth_topic, truth_csv) {
                 (Some(t), _) => TruthSource::Topic(t),
                 (None, Some(path)) => {
@@ -171,9 +176,7 @@ pub fn run(command: Command) -> Result<(), String> {
                 out_bag: out.as_deref(),
                 csv: csv.as_deref(),
                 score_interval_s: SCORE_INTERVAL_S,
-                // Choice: the node's default frames until replay reads the node's
-                // parameters (`map_frame`, `base_frame`, `publish_tf`) from its file.
-                frames: OutputFrames::default(),
+                frames,
                 compression: if compress {
                     ChunkCompression::Zstd
                 } else {
@@ -346,6 +349,14 @@ fn print_problems(run: &BagRun, coupling: Coupling) {
             "velocities: {} paired with their fix, {} without a fix of their stamp, {} in a \
              foreign frame",
             v.paired, v.unpaired, v.foreign_frame
+        );
+    }
+    if let Some(odom) = run.odom_tf {
+        eprintln!(
+            "map -> odom: {} odom -> base transforms taken from /tf (odom_tf_received), {} \
+             unusable (odom_tf_unusable); {} Odometry messages without a map -> odom \
+             (map_to_odom_missing)",
+            odom.received, odom.unusable, odom.map_to_odom_missing
         );
     }
     for (name, n) in run.counts.dropped().into_iter().filter(|(_, n)| *n > 0) {
