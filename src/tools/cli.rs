@@ -1,14 +1,13 @@
 //! The `gnss_ins` subcommands: argument definitions and what each one does.
 
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 use clap::{Subcommand, ValueEnum};
 
 use crate::config::{Config, Coupling, FilterVariant};
 use crate::ros::adapter::{TIME_JUMP_BACK_S, TIME_JUMP_CONFIRM_SAMPLES};
-use crate::ros::node::params::{node_params_from_files, NodeParams};
 use crate::ros::bag::ChunkCompression;
+use crate::ros::node::params::{node_params_from_files, NodeParams};
 use crate::sim::{Scenario, ScenarioSpec};
 
 use super::bag_run::BagRun;
@@ -19,6 +18,7 @@ use super::compare::{
     NamedConfig,
 };
 use super::plots::{write_plots, FilterRun};
+use super::progress::Progress;
 use super::replay::{self, ReplayOptions, TruthSource};
 use super::simulate::{self, TRUTH_TOPIC};
 use super::start_blocker::start_blocker;
@@ -139,8 +139,12 @@ pub fn run(command: Command) -> Result<(), String> {
         } => {
             let scenario = load_scenario(&scenario, seed)?;
             let options = simulate::SimulateOptions { velocity };
-            let summary =
-                simulate::simulate_with(&scenario, &out, options).map_err(|e| e.to_string())?;
+            let progress = Progress::new();
+            let summary = simulate::simulate_with_progress(&scenario, &out, options, |f| {
+                progress.fraction("simulate", f)
+            });
+            progress.end();
+            let summary = summary.map_err(|e| e.to_string())?;
             eprintln!(
                 "wrote {}: {} IMU samples, {} GNSS epochs, {} fixes, {} velocities, {} reference \
                  samples",
@@ -183,16 +187,12 @@ pub fn run(command: Command) -> Result<(), String> {
                     ChunkCompression::None
                 },
             };
-            let show = std::io::stderr().is_terminal();
+            let progress = Progress::new();
             let result = replay::replay(&bag, &config, truth, &options, |f| {
-                if show {
-                    eprint!("\r{}", progress_bar(f));
-                }
-            })
-            .map_err(|e| e.to_string())?;
-            if show {
-                eprintln!();
-            }
+                progress.fraction("replay", f)
+            });
+            progress.end();
+            let result = result.map_err(|e| e.to_string())?;
             print_problems(&result, config.filter.coupling);
             println!(
                 "{} solutions, {} GNSS updates",
@@ -281,7 +281,10 @@ pub fn run(command: Command) -> Result<(), String> {
                         report,
                     })
                     .collect();
-                let files = write_plots(&dir, &runs).map_err(|e| e.to_string())?;
+                let progress = Progress::new();
+                let files = write_plots(&dir, &runs, |f| progress.fraction("plots", f));
+                progress.end();
+                let files = files.map_err(|e| e.to_string())?;
                 eprintln!("wrote {} figures into {}", files.len(), dir.display());
             }
             Ok(())
@@ -308,17 +311,6 @@ pub fn run(command: Command) -> Result<(), String> {
             Ok(())
         }
     }
-}
-
-fn progress_bar(fraction: f64) -> String {
-    let width = 40;
-    let done = ((fraction.clamp(0.0, 1.0)) * width as f64).round() as usize;
-    format!(
-        "[{}{}] {:5.1} %",
-        "#".repeat(done),
-        " ".repeat(width - done),
-        fraction * 100.0
-    )
 }
 
 /// What the replay skipped and dropped, on stderr: the bag's problems, the adapter's
