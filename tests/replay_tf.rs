@@ -10,16 +10,16 @@
 mod odometry_support;
 mod tf_support;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 use adaptive_gnss_ins::ros::bag::BagReader;
 use adaptive_gnss_ins::ros::msg::{Odometry, TFMessage, TransformStamped};
-use adaptive_gnss_ins::sim::Scenario;
 use odometry_support::{decoded, largest_difference_of_runs};
 use tf_support::{
     assert_map_to_base_link_is_the_odometry, chain, drift, map_to_odom_by_stamp, nanos,
-    write_controller_bag, Chain, CONTROLLER_PERIOD_NS, TOLERANCE,
+    static_scenario, write_controller_bag, write_node_parameters, Chain, CONTROLLER_PERIOD_NS,
+    PRESET, TOLERANCE,
 };
 
 /// Scenario seconds written, as node_tf streams them.
@@ -27,11 +27,6 @@ const STREAM_S: f64 = 20.0;
 /// How far node_tf's controller runs ahead of the IMU (there in scenario time, here in
 /// log time): every Odometry stamp then lies between two controller stamps already read.
 const CONTROLLER_LEAD_NS: i64 = 200_000_000;
-
-/// The static receiver of node_tf (static_node_support).
-fn static_scenario() -> Scenario {
-    Scenario::builtin("static", 3).unwrap()
-}
 
 /// What one replay wrote and said.
 struct Replayed {
@@ -47,27 +42,14 @@ struct Replayed {
 /// node) and `node_parameters`.
 fn replay(bag: &Path, node_parameters: &str) -> Replayed {
     let dir = tempfile::tempdir().unwrap();
-    let scenario = static_scenario();
-    let spec = &scenario.spec().trajectory;
     let node_file = dir.path().join("node.yaml");
-    std::fs::write(
-        &node_file,
-        format!(
-            "/**:\n  ros__parameters:\n    init.heading_deg: 0.0\n    \
-             output.datum_llh_deg_m: [{}, {}, {}]\n{node_parameters}",
-            spec.start_lat_deg, spec.start_lon_deg, spec.start_height_m
-        ),
-    )
-    .unwrap();
+    write_node_parameters(&node_file, &static_scenario(), node_parameters);
     let out = dir.path().join("out.mcap");
-    let preset: PathBuf = [env!("CARGO_MANIFEST_DIR"), "params", "ekf.yaml"]
-        .iter()
-        .collect();
     let run = Command::new(env!("CARGO_BIN_EXE_gnss_ins"))
         .arg("replay")
         .arg(bag)
         .arg("--params")
-        .arg(&preset)
+        .arg(PRESET)
         .arg("--params")
         .arg(&node_file)
         .arg("--out")

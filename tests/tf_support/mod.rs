@@ -17,6 +17,9 @@ use adaptive_gnss_ins::tools::replay::TF_TOPIC;
 use adaptive_gnss_ins::tools::simulate::{GNSS_TOPIC, IMU_TOPIC};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 
+/// The preset the TF tests run the filter with (as static_node_support starts the node).
+pub const PRESET: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/params/ekf.yaml");
+
 /// The base controller's period: 50 Hz.
 pub const CONTROLLER_PERIOD_NS: i64 = 20_000_000;
 /// Choice of tolerance: the adapter interpolates between two controller stamps exactly as
@@ -214,4 +217,25 @@ pub fn write_controller_bag(path: &Path, scenario: &Scenario, stream_s: f64, lea
     }
     bag.finish().unwrap();
     first_imu_ns.unwrap()
+}
+
+/// The static receiver of node_tf (static_node_support).
+pub fn static_scenario() -> Scenario {
+    Scenario::builtin("static", 3).unwrap()
+}
+
+/// Writes a launch-style `/**` parameter file for the node and `replay` with the datum at
+/// `scenario`'s start and a known heading (as static_node_support starts the node),
+/// followed by `node_parameters` (YAML lines indented by 4).
+pub fn write_node_parameters(path: &Path, scenario: &Scenario, node_parameters: &str) {
+    let spec = &scenario.spec().trajectory;
+    std::fs::write(
+        path,
+        format!(
+            "/**:\n  ros__parameters:\n    init.heading_deg: 0.0\n    \
+             output.datum_llh_deg_m: [{}, {}, {}]\n{node_parameters}",
+            spec.start_lat_deg, spec.start_lon_deg, spec.start_height_m
+        ),
+    )
+    .unwrap();
 }
