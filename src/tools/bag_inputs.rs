@@ -162,10 +162,11 @@ impl ReadProblems {
 pub enum BagInput {
     /// A message for the adapter.
     Message(InputMessage),
-    /// A `/tf` message for the adapter ([`RosAdapter::on_tf`](crate::ros::adapter::RosAdapter::on_tf)).
+    /// A `/tf` message for the adapter
+    /// ([`RosAdapter::on_tf`](crate::ros::adapter::RosAdapter::on_tf)).
     Tf(TFMessage),
-    /// A message on an input topic or `/tf` that did not decode (the adapter counts it, as the
-    /// node counts an undecodable payload).
+    /// A message on an input topic or `/tf` that did not decode (the adapter counts it, as
+    /// the node counts an undecodable payload).
     Undecodable { topic: String, error: String },
     /// A reference for the scoring.
     Reference(Reference),
