@@ -93,7 +93,8 @@ fn run_peer(python: &Path, script: &str, namespace: &str, extra_args: &[&str]) -
 }
 
 /// The peer first lists, reads, describes and sets parameters through the node's
-/// parameter services (leaving them as they were), then plays the bag with its time on
+/// parameter services (leaving them as they were; each accepted set announced on
+/// /parameter_events), then plays the bag with its time on
 /// /clock (the node runs with use_sim_time) and checks every output, /rosout too, and
 /// that every solution equals `gnss_ins replay`'s (tests/data/fixture_small_solution.csv).
 #[test]
@@ -115,6 +116,12 @@ fn cyclonedds_peer_sets_parameters_and_plays_a_bag_into_the_node() {
     assert!(summary["odometry"]["count"].as_u64().unwrap_or(0) > 2000);
     assert!(summary["golden"]["matched"].as_u64().unwrap_or(0) > 2000);
     assert!(summary["parameters"]["listed"].as_u64().unwrap_or(0) > 50);
+    let announced = &summary["parameters"]["parameter_events"]["announced"];
+    assert_eq!(
+        announced.as_array().map(Vec::len),
+        Some(2),
+        "one /parameter_events event per accepted set: {announced}"
+    );
 }
 
 /// Undecodable payloads, wrong array sizes, NaN, repeated and backward stamps, GNSS before

@@ -9,88 +9,31 @@
 
 mod netns_support;
 mod static_node_support;
+mod tf_support;
 
 use std::time::{Duration, Instant};
 
 use adaptive_gnss_ins::ros::convert::seconds_to_time;
-use adaptive_gnss_ins::ros::msg::{
-    GnssMeasurements, Header, Odometry, Quaternion, TFMessage, Time, TransformStamped, Vector3,
-};
+use adaptive_gnss_ins::ros::msg::GnssMeasurements;
 use adaptive_gnss_ins::ros::outbound;
 use adaptive_gnss_ins::sim::SimEvent;
-use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 use netns_support::reexec_in_private_netns;
 use static_node_support::{
     collect_outputs, diagnostic_count, start_node, static_scenario, Outputs, Peer,
+};
+use tf_support::{
+    chain, controller_tf, drift, map_to_odom_by_stamp, nanos, Chain, CONTROLLER_PERIOD_NS,
+    TOLERANCE,
 };
 
 const DOMAIN_ID: u16 = 19;
 /// Scenario seconds streamed, and how much faster than real time.
 const STREAM_S: f64 = 20.0;
 const SPEED_UP: f64 = 10.0;
-/// The base controller's period: 50 Hz.
-const CONTROLLER_PERIOD_NS: i64 = 20_000_000;
 /// How far (scenario time) the controller's `/tf` runs ahead of the IMU, so that every
 /// Odometry stamp lies between two controller stamps the node has heard: 0.2 s are 20 ms
 /// of wall time at 10x, against sub-millisecond loopback latencies.
 const CONTROLLER_LEAD_NS: i64 = 200_000_000;
-/// Choice of tolerance: the node interpolates between two controller stamps exactly as
-/// the drift moves (linear translation, constant yaw rate: slerp is exact), and CDR
-/// carries f64 unchanged, so what is left is the rounding of products of 10 m-scale
-/// poses (~1e-14 m). 1e-12 m and rad catch a transform held one controller period
-/// (0.5 m/s × 20 ms = 1 cm), a wrong composition order, and an interpolated rotation
-/// left unnormalized (1.1e-9 m, measured here before the adapter renormalized it).
-const TOLERANCE: f64 = 1e-12;
-
-fn nanos(t: &Time) -> i64 {
-    i64::from(t.sec) * 1_000_000_000 + i64::from(t.nanosec)
-}
-
-fn time(ns: i64) -> Time {
-    Time {
-        sec: ns.div_euclid(1_000_000_000) as i32,
-        nanosec: ns.rem_euclid(1_000_000_000) as u32,
-    }
-}
-
-/// The wheel odometry's `odom → base_link` at `ns`: drifting 0.5 m/s east, 0.1 m/s north
-/// and 0.05 rad/s of yaw from `start_ns`.
-fn drift(ns: i64, start_ns: i64) -> Isometry3<f64> {
-    let t_s = (ns - start_ns) as f64 * 1e-9;
-    Isometry3::from_parts(
-        Translation3::new(0.5 * t_s, 0.1 * t_s, 0.0),
-        UnitQuaternion::from_euler_angles(0.0, 0.0, 0.05 * t_s),
-    )
-}
-
-fn controller_tf(ns: i64, pose: &Isometry3<f64>) -> TFMessage {
-    let header = Header {
-        stamp: time(ns),
-        frame_id: "odom".to_owned(),
-    };
-    TFMessage {
-        transforms: vec![outbound::transform_stamped(header, "base_link", pose)],
-    }
-}
-
-fn isometry(t: &Vector3, q: &Quaternion) -> Isometry3<f64> {
-    Isometry3::from_parts(
-        Translation3::new(t.x, t.y, t.z),
-        UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(q.w, q.x, q.y, q.z)),
-    )
-}
-
-fn odometry_pose(o: &Odometry) -> Isometry3<f64> {
-    let p = &o.pose.pose.position;
-    isometry(
-        &Vector3 {
-            x: p.x,
-            y: p.y,
-            z: p.z,
-        },
-        &o.pose.pose.orientation,
-    )
-}
 
 #[test]
 fn map_to_odom_chained_with_the_controllers_odom_is_the_fused_pose() {
@@ -182,49 +125,18 @@ fn map_to_odom_chained_with_the_controllers_odom_is_the_fused_pose() {
 
     // base_link has one parent: the controller's odom. Everything else on /tf is the
     // node's map -> odom.
-    for t in &transforms {
-        if t.child_frame_id == "base_link" {
-            assert_eq!(
-                t.header.frame_id, "odom",
-                "a second parent of base_link: {t:?}"
-            );
-        } else {
-            assert_eq!(
-                (t.header.frame_id.as_str(), t.child_frame_id.as_str()),
-                ("map", "odom"),
-                "{t:?}"
-            );
-        }
-    }
-    let map_to_odom: std::collections::HashMap<i64, &TransformStamped> = transforms
-        .iter()
-        .filter(|t| t.child_frame_id == "odom")
-        .map(|t| (nanos(&t.header.stamp), t))
-        .collect();
+    let map_to_odom = map_to_odom_by_stamp(&transforms);
     // One Odometry per IMU sample from the initialization at 1 s: about 1900.
     assert!(
         odometry.len() > 1500,
         "only {} Odometry messages received",
         odometry.len()
     );
-    let (mut matched, mut worst_m, mut worst_rad) = (0, 0.0f64, 0.0f64);
-    for o in &odometry {
-        assert_eq!(
-            (o.header.frame_id.as_str(), o.child_frame_id.as_str()),
-            ("map", "base_link"),
-            "the Odometry keeps its REP-105 meaning"
-        );
-        let ns = nanos(&o.header.stamp);
-        let Some(t) = map_to_odom.get(&ns) else {
-            continue;
-        };
-        let map_odom = isometry(&t.transform.translation, &t.transform.rotation);
-        let chained = map_odom * drift(ns, first_imu_ns);
-        let d = chained.inverse() * odometry_pose(o);
-        worst_m = worst_m.max(d.translation.vector.norm());
-        worst_rad = worst_rad.max(d.rotation.angle());
-        matched += 1;
-    }
+    let Chain {
+        matched,
+        worst_m,
+        worst_rad,
+    } = chain(&odometry, &map_to_odom, |ns| drift(ns, first_imu_ns));
     eprintln!(
         "{} Odometry, {} map -> odom, {matched} matched, {controller_sent} controller \
          transforms sent; largest chain error {worst_m:.3e} m, {worst_rad:.3e} rad",

@@ -2,13 +2,15 @@
 //! GnssMeasurements message of the fixture bag, unchanged and in order, and /clock
 //! follows the bag's time; and the bag played into `gnss_ins_node --record` gives the
 //! Odometry that `gnss_ins replay` computes from the same bag, tightly coupled and (on a
-//! simulated bag with `/gnss/velocity`) loosely coupled with receiver velocities.
+//! simulated bag with `/gnss/velocity`) loosely coupled with receiver velocities, and in
+//! `tf_mode` `map_to_odom` (a bag with a base controller's `/tf`) the same `map → odom`.
 //!
 //! DDS traffic stays on this machine: the test re-executes itself inside a private
 //! network namespace that has only loopback (`unshare -n`, needs root).
 
 mod netns_support;
 mod odometry_support;
+mod tf_support;
 
 use std::path::Path;
 use std::process::{Command, Stdio};
@@ -17,7 +19,9 @@ use std::time::{Duration, Instant};
 use adaptive_gnss_ins::config::Config;
 use adaptive_gnss_ins::ros::bag::BagReader;
 use adaptive_gnss_ins::ros::cdr;
-use adaptive_gnss_ins::ros::msg::{Clock, GnssMeasurements, Imu, Odometry, RosMessage};
+use adaptive_gnss_ins::ros::msg::{
+    Clock, GnssMeasurements, Imu, Odometry, RosMessage, TFMessage, TransformStamped,
+};
 use adaptive_gnss_ins::sim::{Scenario, ScenarioSpec};
 use adaptive_gnss_ins::tools::bag_run::BagRun;
 use adaptive_gnss_ins::tools::replay::{replay, ReplayOptions, TruthSource};
@@ -305,6 +309,102 @@ fn node_records_the_replay_solution(
     );
     assert!(worst <= 1e-9, "node and replay differ by {worst}");
     result
+}
+
+/// The node's `/tf` in `tf_mode` `map_to_odom` has its offline twin (issue 16, item 2): a
+/// bag of the static receiver with a stand-in base controller's `odom → base_link` on
+/// `/tf` (logged ahead of the IMU, tests/tf_support), played into the node started with
+/// a parameter file, gives the `map → odom` that `gnss_ins replay` of the bag with the same
+/// file writes: the same transforms at the same stamps, equal within 1e-9.
+#[test]
+fn node_records_the_replay_tf_in_map_to_odom_mode() {
+    if reexec_in_private_netns("node_records_the_replay_tf_in_map_to_odom_mode") {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let bag = dir.path().join("controller.mcap");
+    let scenario = tf_support::static_scenario();
+    tf_support::write_controller_bag(&bag, &scenario, 20.0, 200_000_000);
+    let node_file = dir.path().join("node.yaml");
+    let map_to_odom = "    publish_tf: true\n    tf_mode: map_to_odom\n";
+    tf_support::write_node_parameters(&node_file, &scenario, map_to_odom);
+    let recorded = dir.path().join("node.mcap");
+    let replayed = dir.path().join("replay.mcap");
+    let node_args: Vec<String> = [
+        "-r",
+        "__node:=tf_test",
+        "--params-file",
+        tf_support::PRESET,
+        "--params-file",
+        node_file.to_str().unwrap(),
+    ]
+    .map(str::to_owned)
+    .to_vec();
+    let play_args = [
+        "--rate",
+        "2",
+        "--wait-for",
+        "/imu",
+        "--wait-for",
+        "/gnss/measurements",
+        "--wait-for",
+        "/tf",
+    ];
+    record_node_playing(
+        &bag,
+        &recorded,
+        &node_args,
+        &play_args,
+        &(DOMAIN_ID + 4).to_string(),
+    );
+    let status = Command::new(env!("CARGO_BIN_EXE_gnss_ins"))
+        .arg("replay")
+        .arg(&bag)
+        .args(["--params", tf_support::PRESET, "--params"])
+        .arg(&node_file)
+        .arg("--out")
+        .arg(&replayed)
+        .stderr(Stdio::null())
+        .status()
+        .unwrap();
+    assert!(status.success(), "replay failed: {status}");
+
+    let live = decoded::<Odometry>(&recorded, "/odometry");
+    let offline = decoded::<Odometry>(&replayed, "/odometry");
+    let worst = largest_difference_of_runs(&live, &offline, "node vs replay");
+    assert!(worst <= 1e-9, "node and replay Odometry differ by {worst}");
+    let transforms = |bag: &Path| -> Vec<TransformStamped> {
+        decoded::<TFMessage>(bag, "/tf")
+            .into_iter()
+            .flat_map(|m| m.transforms)
+            .filter(|t| t.header.frame_id == "map")
+            .collect()
+    };
+    let (live_tf, offline_tf) = (transforms(&recorded), transforms(&replayed));
+    assert!(live.len() > 1500, "{} Odometry recorded", live.len());
+    assert_eq!(live_tf.len(), live.len(), "one map -> odom per Odometry");
+    assert_eq!(
+        live_tf.len(),
+        offline_tf.len(),
+        "map -> odom: node vs replay"
+    );
+    let mut worst_tf = 0.0f64;
+    for (a, b) in live_tf.iter().zip(&offline_tf) {
+        assert_eq!(a.header, b.header);
+        assert_eq!(a.child_frame_id, b.child_frame_id);
+        let d = tf_support::transform_of(a).inverse() * tf_support::transform_of(b);
+        worst_tf = worst_tf
+            .max(d.translation.vector.norm())
+            .max(d.rotation.angle());
+    }
+    println!(
+        "node vs replay: {} map -> odom, largest difference {worst_tf:e}",
+        live_tf.len()
+    );
+    assert!(
+        worst_tf <= 1e-9,
+        "node and replay map -> odom differ by {worst_tf}"
+    );
 }
 
 /// A drive for joining in its middle: 10 s at rest, then 10 m/s in a steady turn of 3 deg/s

@@ -190,6 +190,7 @@ fn spp_rinex_tool_writes_one_line_per_epoch() {
         &root.join("walk_1730.nav"),
         &csv,
         &options,
+        |_| {},
     )
     .unwrap();
     assert_eq!((summary.epochs, summary.solved), (536, 528));
@@ -212,6 +213,13 @@ fn spp_rinex_tool_writes_one_line_per_epoch() {
     assert_eq!(unsolved, 8);
     // A missing file is an error naming it.
     let missing = root.join("no_such.obs");
-    let err = spp_rinex(&missing, &root.join("walk_1730.nav"), &csv, &options).unwrap_err();
+    let err = spp_rinex(
+        &missing,
+        &root.join("walk_1730.nav"),
+        &csv,
+        &options,
+        |_| {},
+    )
+    .unwrap_err();
     assert!(err.to_string().contains("no_such.obs"), "{err}");
 }

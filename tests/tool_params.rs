@@ -1,7 +1,8 @@
 //! `gnss_ins replay` and `compare` read their `--params` files as the node does: any
 //! number, in order (a later value wins), nested or dotted keys, the node's own
-//! parameters accepted and ignored (issue 16: `replay` refused `use_sim_time` and a second
-//! file).
+//! parameters accepted (issue 16: `replay` refused `use_sim_time` and a second file;
+//! `replay` checks them as the node does and frames its outputs and TF by them, `compare`
+//! ignores them).
 
 use std::path::Path;
 use std::process::{Command, Output};
@@ -36,7 +37,7 @@ fn replay_takes_the_manual_then_a_launch_style_file() {
     let file = dir.path().join("launch_style.yaml");
     std::fs::write(
         &file,
-        "/**:\n  ros__parameters:\n    use_sim_time: true\n    map_frame: odom\n    \
+        "/**:\n  ros__parameters:\n    use_sim_time: true\n    map_frame: enu\n    \
          filter.variant: ermakf\n",
     )
     .unwrap();

@@ -284,6 +284,16 @@ class Parameter(IdlStruct, typename=_name('rcl_interfaces', 'msg', 'Parameter'))
 
 @dataclass
 @annotate.final
+class ParameterEvent(IdlStruct, typename=_name('rcl_interfaces', 'msg', 'ParameterEvent')):
+    stamp: Time = field(default_factory=Time)
+    node: str = ''
+    new_parameters: sequence[Parameter] = field(default_factory=list)
+    changed_parameters: sequence[Parameter] = field(default_factory=list)
+    deleted_parameters: sequence[Parameter] = field(default_factory=list)
+
+
+@dataclass
+@annotate.final
 class SetParametersResult(IdlStruct,
                           typename=_name('rcl_interfaces', 'msg', 'SetParametersResult')):
     successful: bool = False

@@ -3,7 +3,10 @@ used by cyclonedds_peer.py --parameters against gnss_ins_node's parameter servic
 
 `exercise` lists, reads, describes and sets parameters, checks the answers against the
 node's documented behaviour (params/ekf.yaml defaults; runtime parameters settable,
-the rest read-only) and leaves every parameter as it found it.
+the rest read-only) and leaves every parameter as it found it. It listens on
+/parameter_events (reliable, keep last 1000, as rclcpp's subscribers) and requires one
+event with the name and the new value in changed_parameters per accepted set, and none
+for a refused one.
 """
 
 import random
@@ -74,6 +77,8 @@ def exercise(participant, namespace, node, sim_time, checks):
                              P.SetParametersResponse),
     }
     summary = {}
+    fqn = base.rstrip('/')
+    events = reader(participant, 'rt/parameter_events', P.ParameterEvent, xcdr1_qos(depth=1000))
 
     def call(kind, request):
         reply = clients[kind].call(request)
@@ -125,6 +130,11 @@ def exercise(participant, namespace, node, sim_time, checks):
         reply = call('get', P.GetParametersRequest(names=['gnss.elevation_mask_deg']))
         return reply.values[0].double_value if reply is not None else None
 
+    # The node's /parameter_events writer must have matched before the first set.
+    deadline = time.monotonic() + 20.0
+    while not events.get_matched_publications() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    checks.that(bool(events.get_matched_publications()), 'no /parameter_events writer matched')
     applied = set_one('gnss.elevation_mask_deg', double(12.5))
     checks.that(applied is not None and applied.successful, f'set elevation mask: {applied}')
     checks.that(mask_value() == 12.5, 'the elevation mask reads back as set')
@@ -139,6 +149,21 @@ def exercise(participant, namespace, node, sim_time, checks):
     restored = set_one('gnss.elevation_mask_deg', double(10.0))
     checks.that(restored is not None and restored.successful, 'restore the elevation mask')
     checks.that(mask_value() == 10.0, 'the elevation mask is back at its default')
+
+    accepted = [[('gnss.elevation_mask_deg', 12.5)], [('gnss.elevation_mask_deg', 10.0)]]
+    received = []
+    deadline = time.monotonic() + 2.0
+    while True:
+        received.extend(e for e in events.take(N=100)
+                        if e.node == fqn and e.changed_parameters)
+        if len(received) >= len(accepted) or time.monotonic() > deadline:
+            break
+        time.sleep(0.01)
+    announced = [[(p.name, p.value.double_value) for p in e.changed_parameters]
+                 for e in received]
+    checks.that(announced == accepted,
+                f'/parameter_events announced {announced}, the accepted sets were {accepted}')
+    summary['parameter_events'] = {'announced': announced}
 
     latencies = sorted(t for c in clients.values() for t in c.latencies_s)
     if latencies:

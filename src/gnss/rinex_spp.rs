@@ -108,6 +108,16 @@ pub fn solve_rinex_spp(
     nav: &RinexNav,
     options: &RinexSppOptions,
 ) -> Vec<RinexSppEpoch> {
+    solve_rinex_spp_with_progress(obs, nav, options, |_| {})
+}
+
+/// [`solve_rinex_spp`], calling `progress` with the fraction of the epochs solved.
+pub fn solve_rinex_spp_with_progress(
+    obs: &RinexObs,
+    nav: &RinexNav,
+    options: &RinexSppOptions,
+    mut progress: impl FnMut(f64),
+) -> Vec<RinexSppEpoch> {
     let mut store = EphemerisStore::new();
     for eph in &nav.ephemerides {
         store.insert(*eph);
@@ -118,7 +128,8 @@ pub fn solve_rinex_spp(
     };
     let mut previous: Option<Vector3<f64>> = None;
     let mut out = Vec::with_capacity(obs.epochs.len());
-    for epoch in &obs.epochs {
+    for (k, epoch) in obs.epochs.iter().enumerate() {
+        progress(k as f64 / obs.epochs.len() as f64);
         let mut built = build_rinex_epoch(epoch, &store, klobuchar);
         if !options.constellations.is_empty() {
             built

@@ -197,7 +197,14 @@ fn create_writer<M: Serialize>(
 
 /// Plays `bag` onto DDS; returns when the bag has played (never with `repeat`, unless
 /// the bag cannot be read).
-pub fn play(bag: &Path, options: &PlayOptions) -> Result<PlayReport, PlayError> {
+///
+/// `progress` is called before each message with the pass (0 the first) and the
+/// fraction of the bag's messages that pass has played.
+pub fn play(
+    bag: &Path,
+    options: &PlayOptions,
+    mut progress: impl FnMut(u64, f64),
+) -> Result<PlayReport, PlayError> {
     if !(MIN_RATE..=MAX_RATE).contains(&options.rate) {
         return Err(PlayError::Rate(options.rate));
     }
@@ -245,7 +252,16 @@ pub fn play(bag: &Path, options: &PlayOptions) -> Result<PlayReport, PlayError> 
 
     let mut report = PlayReport::default();
     loop {
-        play_once(&reader, &writers, clock.as_ref(), options, &mut report)?;
+        let pass = report.passes;
+        let mut progress = |f| progress(pass, f);
+        play_once(
+            &reader,
+            &writers,
+            clock.as_ref(),
+            options,
+            &mut report,
+            &mut progress,
+        )?;
         wait_for_acknowledgements(&writers);
         report.passes += 1;
         if !options.repeat {
@@ -317,8 +333,10 @@ fn play_once(
     clock: Option<&DataWriterCdr<Clock>>,
     options: &PlayOptions,
     report: &mut PlayReport,
+    progress: &mut dyn FnMut(f64),
 ) -> Result<(), PlayError> {
     let started = Instant::now();
+    let total: u64 = reader.topics().iter().map(|t| t.message_count).sum();
     let mut bag_start_ns = None;
     let mut first_ns = None;
     let offset_ns = u64::try_from(options.start_offset.as_nanos()).unwrap_or(u64::MAX);
@@ -328,7 +346,8 @@ fn play_once(
     } else {
         u64::MAX
     };
-    for message in reader.messages()? {
+    for (k, message) in reader.messages()?.enumerate() {
+        progress(k as f64 / total.max(1) as f64);
         let BagMessage {
             topic,
             log_time_ns,
@@ -431,11 +450,11 @@ mod tests {
         };
         let missing = Path::new("/nonexistent/bag.mcap");
         for rate in [1e-300, 0.0, -1.0, f64::NAN, f64::INFINITY, 1e300] {
-            let err = play(missing, &options(rate, 100.0)).unwrap_err();
+            let err = play(missing, &options(rate, 100.0), |_, _| {}).unwrap_err();
             assert!(matches!(err, PlayError::Rate(_)), "rate {rate}: {err}");
         }
         for clock_hz in [1e-300, 0.0, f64::NAN, 1e300] {
-            let err = play(missing, &options(1.0, clock_hz)).unwrap_err();
+            let err = play(missing, &options(1.0, clock_hz), |_, _| {}).unwrap_err();
             assert!(
                 matches!(err, PlayError::ClockRate(_)),
                 "clock {clock_hz}: {err}"

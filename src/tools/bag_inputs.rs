@@ -14,7 +14,7 @@ use crate::ros::cdr;
 use crate::ros::convert::time_to_seconds;
 use crate::ros::msg::{
     DiagnosticArray, GnssMeasurements, Imu, NavSatFix, NoiseEstimates, Odometry, RosMessage,
-    TwistWithCovarianceStamped,
+    TFMessage, TwistWithCovarianceStamped,
 };
 
 use super::scoring::Reference;
@@ -35,6 +35,10 @@ pub struct BagTopics {
     /// nav_msgs/Odometry of the base controller, whose forward speed is fed with
     /// `wheel_odometry.enabled`.
     pub wheel_odometry: String,
+    /// tf2_msgs/TFMessage with the base controller's `odom_frame → base_frame`, read only
+    /// when the run publishes `map → odom` (`tf_mode` `map_to_odom`, as the node then
+    /// subscribes `/tf`); None: not read.
+    pub tf: Option<String>,
     /// nav_msgs/Odometry reference in an ENU frame at `truth_datum` (None: no reference).
     pub truth: Option<String>,
     pub truth_datum: String,
@@ -51,6 +55,7 @@ impl Default for BagTopics {
             fix: FIX_TOPIC.to_owned(),
             velocity: VELOCITY_TOPIC.to_owned(),
             wheel_odometry: WHEEL_ODOMETRY_TOPIC.to_owned(),
+            tf: None,
             truth: Some(TRUTH_TOPIC.to_owned()),
             truth_datum: TRUTH_DATUM_TOPIC.to_owned(),
             truth_noise: TRUTH_NOISE_TOPIC.to_owned(),
@@ -63,6 +68,8 @@ impl Default for BagTopics {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Role {
     Input(Input),
+    /// The base controller's `/tf`, for the adapter's `map → odom`.
+    Tf,
     TruthDatum,
     Truth,
     TruthNoise,
@@ -77,6 +84,7 @@ impl Role {
             Role::Input(Input::Fix) | Role::TruthDatum => NavSatFix::TYPE_NAME,
             Role::Input(Input::Velocity) => TwistWithCovarianceStamped::TYPE_NAME,
             Role::Input(Input::WheelOdometry) | Role::Truth => Odometry::TYPE_NAME,
+            Role::Tf => TFMessage::TYPE_NAME,
             Role::TruthNoise => NoiseEstimates::TYPE_NAME,
             Role::Environment => DiagnosticArray::TYPE_NAME,
         }
@@ -96,6 +104,8 @@ impl BagTopics {
             Some(Role::Input(Input::Velocity))
         } else if topic == self.wheel_odometry {
             Some(Role::Input(Input::WheelOdometry))
+        } else if self.tf.as_deref() == Some(topic) {
+            Some(Role::Tf)
         } else if topic == self.truth_datum {
             Some(Role::TruthDatum)
         } else if self.truth.as_deref() == Some(topic) {
@@ -152,8 +162,11 @@ impl ReadProblems {
 pub enum BagInput {
     /// A message for the adapter.
     Message(InputMessage),
-    /// A message on an input topic that did not decode (the adapter counts it, as the
-    /// node counts an undecodable payload).
+    /// A `/tf` message for the adapter
+    /// ([`RosAdapter::on_tf`](crate::ros::adapter::RosAdapter::on_tf)).
+    Tf(TFMessage),
+    /// A message on an input topic or `/tf` that did not decode (the adapter counts it, as
+    /// the node counts an undecodable payload).
     Undecodable { topic: String, error: String },
     /// A reference for the scoring.
     Reference(Reference),
@@ -234,7 +247,7 @@ impl BagInputs {
             }
             Err(error) => {
                 count(&mut self.problems.undecodable, format!("{topic}: {error}"));
-                matches!(role, Role::Input(_)).then(|| BagInput::Undecodable {
+                matches!(role, Role::Input(_) | Role::Tf).then(|| BagInput::Undecodable {
                     topic: topic.to_owned(),
                     error,
                 })
@@ -255,6 +268,7 @@ impl BagInputs {
             Role::Input(Input::WheelOdometry) => {
                 InputMessage::WheelOdometry(Box::new(decode(data)?))
             }
+            Role::Tf => return Ok(Some(BagInput::Tf(decode(data)?))),
             Role::TruthDatum => {
                 let msg: NavSatFix = decode(data)?;
                 self.datum = Some(Llh::from_degrees(msg.latitude, msg.longitude, msg.altitude));

@@ -9,7 +9,7 @@ use std::path::Path;
 use crate::config::{Config, Coupling};
 use crate::engine::{InitPhase, RejectionCounters, RejectionReason};
 use crate::eval::ErrorSummary;
-use crate::ros::adapter::{Input, InputCounts, OutputFrames, Published, RosAdapter};
+use crate::ros::adapter::{Input, InputCounts, OdomTfCounts, OutputFrames, Published, RosAdapter};
 use crate::ros::bag::{BagError, BagReader};
 
 use super::bag_inputs::{BagInput, BagInputs, BagTopics, ReadProblems};
@@ -44,6 +44,8 @@ pub struct BagRun {
     pub counts: InputCounts,
     /// Velocities dropped for want of a fix of their stamp.
     pub unpaired_velocities: u64,
+    /// What became of the base controller's `/tf` (`tf_mode` `map_to_odom` only).
+    pub odom_tf: Option<OdomTfCounts>,
     /// The engine's rejections by reason.
     pub rejections: RejectionCounters,
     /// Where the start-up stood at the end of the bag (None: the filter was running).
@@ -175,6 +177,7 @@ impl BagRunner {
                         self.scorer.on_published(published);
                     }
                 }
+                BagInput::Tf(tf) => self.adapter.on_tf(&tf),
                 BagInput::Undecodable { topic, error } => {
                     self.adapter.on_undecodable(&topic, &error);
                 }
@@ -192,6 +195,7 @@ impl BagRunner {
             problems: self.inputs.problems().clone(),
             counts: self.adapter.counts().clone(),
             unpaired_velocities: self.adapter.unpaired_velocities(),
+            odom_tf: self.adapter.odom_tf_counts(),
             rejections: self.adapter.engine().counters().clone(),
             start_phase: self.adapter.engine().init_phase(),
         })

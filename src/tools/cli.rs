@@ -1,13 +1,13 @@
 //! The `gnss_ins` subcommands: argument definitions and what each one does.
 
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 use clap::{Subcommand, ValueEnum};
 
 use crate::config::{Config, Coupling, FilterVariant};
-use crate::ros::adapter::{OutputFrames, TIME_JUMP_BACK_S, TIME_JUMP_CONFIRM_SAMPLES};
+use crate::ros::adapter::{TIME_JUMP_BACK_S, TIME_JUMP_CONFIRM_SAMPLES};
 use crate::ros::bag::ChunkCompression;
+use crate::ros::node::params::{node_params_from_files, NodeParams};
 use crate::sim::{Scenario, ScenarioSpec};
 
 use super::bag_run::BagRun;
@@ -18,6 +18,7 @@ use super::compare::{
     NamedConfig,
 };
 use super::plots::{write_plots, FilterRun};
+use super::progress::Progress;
 use super::replay::{self, ReplayOptions, TruthSource};
 use super::simulate::{self, TRUTH_TOPIC};
 use super::start_blocker::start_blocker;
@@ -52,7 +53,9 @@ pub enum Command {
         /// params/ermakf.yaml (a later value wins). Defaults when absent.
         #[arg(long)]
         params: Vec<PathBuf>,
-        /// Output bag with /odometry, /fix/filtered and /noise_estimates.
+        /// Output bag with /odometry, /fix/filtered, /noise_estimates and, with publish_tf in
+        /// a --params file, /tf as the node publishes it (tf_mode map_to_odom reads the
+        /// base controller's odom -> base_link from the bag's /tf).
         #[arg(long)]
         out: Option<PathBuf>,
         /// zstd-compress the output bag's chunks: half the size, for about 1.5 s more CPU
@@ -136,8 +139,12 @@ pub fn run(command: Command) -> Result<(), String> {
         } => {
             let scenario = load_scenario(&scenario, seed)?;
             let options = simulate::SimulateOptions { velocity };
-            let summary =
-                simulate::simulate_with(&scenario, &out, options).map_err(|e| e.to_string())?;
+            let progress = Progress::new();
+            let summary = simulate::simulate_with_progress(&scenario, &out, options, |f| {
+                progress.fraction("simulate", f)
+            });
+            progress.end();
+            let summary = summary.map_err(|e| e.to_string())?;
             eprintln!(
                 "wrote {}: {} IMU samples, {} GNSS epochs, {} fixes, {} velocities, {} reference \
                  samples",
@@ -160,7 +167,9 @@ pub fn run(command: Command) -> Result<(), String> {
             truth_topic,
             truth_csv,
         } => {
-            let config = load_config(&params)?;
+            // The node's own parameters too: the frames and the TF are the node's.
+            let NodeParams { config, frames, .. } =
+                node_params_from_files(&params).map_err(|e| e.to_string())?;
             let truth = match (truth_topic, truth_csv) {
                 (Some(t), _) => TruthSource::Topic(t),
                 (None, Some(path)) => {
@@ -172,25 +181,19 @@ pub fn run(command: Command) -> Result<(), String> {
                 out_bag: out.as_deref(),
                 csv: csv.as_deref(),
                 score_interval_s: SCORE_INTERVAL_S,
-                // Choice: the node's default frames until replay reads the node's
-                // parameters (`map_frame`, `base_frame`, `publish_tf`) from its file.
-                frames: OutputFrames::default(),
+                frames,
                 compression: if compress {
                     ChunkCompression::Zstd
                 } else {
                     ChunkCompression::None
                 },
             };
-            let show = std::io::stderr().is_terminal();
+            let progress = Progress::new();
             let result = replay::replay(&bag, &config, truth, &options, |f| {
-                if show {
-                    eprint!("\r{}", progress_bar(f));
-                }
-            })
-            .map_err(|e| e.to_string())?;
-            if show {
-                eprintln!();
-            }
+                progress.fraction("replay", f)
+            });
+            progress.end();
+            let result = result.map_err(|e| e.to_string())?;
             print_problems(&result, config.filter.coupling);
             println!(
                 "{} solutions, {} GNSS updates",
@@ -279,7 +282,10 @@ pub fn run(command: Command) -> Result<(), String> {
                         report,
                     })
                     .collect();
-                let files = write_plots(&dir, &runs).map_err(|e| e.to_string())?;
+                let progress = Progress::new();
+                let files = write_plots(&dir, &runs, |f| progress.fraction("plots", f));
+                progress.end();
+                let files = files.map_err(|e| e.to_string())?;
                 eprintln!("wrote {} figures into {}", files.len(), dir.display());
             }
             Ok(())
@@ -306,17 +312,6 @@ pub fn run(command: Command) -> Result<(), String> {
             Ok(())
         }
     }
-}
-
-fn progress_bar(fraction: f64) -> String {
-    let width = 40;
-    let done = ((fraction.clamp(0.0, 1.0)) * width as f64).round() as usize;
-    format!(
-        "[{}{}] {:5.1} %",
-        "#".repeat(done),
-        " ".repeat(width - done),
-        fraction * 100.0
-    )
 }
 
 /// What the replay skipped and dropped, on stderr: the bag's problems, the adapter's
@@ -347,6 +342,14 @@ fn print_problems(run: &BagRun, coupling: Coupling) {
             "velocities: {} paired with their fix, {} without a fix of their stamp, {} in a \
              foreign frame",
             v.paired, v.unpaired, v.foreign_frame
+        );
+    }
+    if let Some(odom) = run.odom_tf {
+        eprintln!(
+            "map -> odom: {} odom -> base transforms taken from /tf (odom_tf_received), {} \
+             unusable (odom_tf_unusable); {} Odometry messages without a map -> odom \
+             (map_to_odom_missing)",
+            odom.received, odom.unusable, odom.map_to_odom_missing
         );
     }
     for (name, n) in run.counts.dropped().into_iter().filter(|(_, n)| *n > 0) {

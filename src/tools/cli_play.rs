@@ -8,6 +8,8 @@ use clap::Args;
 use crate::ros::node::domain_id_from;
 use crate::ros::player::{self, PlayOptions};
 
+use super::progress::Progress;
+
 #[derive(Args)]
 pub struct PlayArgs {
     /// The bag to play: an .mcap file or a rosbag2 directory holding one.
@@ -61,7 +63,17 @@ pub fn play(args: PlayArgs) -> Result<(), String> {
         wait_for_topics: args.wait_for,
         domain_id,
     };
-    let report = player::play(&args.bag, &options).map_err(|e| e.to_string())?;
+    let line = Progress::new();
+    let report = player::play(&args.bag, &options, |pass, f| {
+        let what = if options.repeat {
+            format!("play, pass {}", pass + 1)
+        } else {
+            "play".to_owned()
+        };
+        line.fraction(&what, f)
+    });
+    line.end();
+    let report = report.map_err(|e| e.to_string())?;
     for (topic, n) in &report.published {
         println!("{topic}: {n} published");
     }

@@ -6,14 +6,15 @@ use std::path::PathBuf;
 use clap::{Args, ValueEnum};
 
 use super::convert::{
-    convert as convert_files, ConvertOptions, ConvertSummary, EphemerisMode, GnssSource, ImuInput,
-    ImuTime, TruthInput,
+    convert_with_progress as convert_files, ConvertOptions, ConvertSummary, EphemerisMode,
+    GnssSource, ImuInput, ImuTime, TruthInput,
 };
 use super::convert_bag::{
     RobotBag, RobotBagSummary, RobotBagTopics, UbxInput, DEFAULT_IMU_TOPIC, DEFAULT_RAWX_TOPIC,
     DEFAULT_SFRBX_TOPIC, DEFAULT_STREAM_TOPIC,
 };
 use super::imu_csv::{AccelUnit, GyroUnit, ImuCsvFormat};
+use super::progress::Progress;
 use super::simulate::TRUTH_TOPIC;
 use super::spp_rinex::spp_rinex as solve_rinex_files;
 use super::spp_run::{bag_spp_inputs, run_spp_with, write_spp_csv};
@@ -438,7 +439,12 @@ fn print_robot_bag_summary(s: &RobotBagSummary) {
 /// `gnss_ins convert`.
 pub fn convert(args: ConvertArgs) -> Result<(), String> {
     let options = args.options()?;
-    let summary = convert_files(&options, &args.out).map_err(|e| e.to_string())?;
+    let progress = Progress::new();
+    let summary = convert_files(&options, &args.out, &mut |phase, f| {
+        progress.fraction(&format!("convert, {phase}"), f)
+    });
+    progress.end();
+    let summary = summary.map_err(|e| e.to_string())?;
     print_convert_summary(&args.out, &summary);
     if let Some(leap) = summary.receiver_leap_seconds {
         if f64::from(leap) != options.leap_seconds {
@@ -454,6 +460,7 @@ pub fn convert(args: ConvertArgs) -> Result<(), String> {
 /// `gnss_ins spp`.
 pub fn spp(args: SppArgs) -> Result<(), String> {
     let config = config_from_files(&args.params).map_err(|e| e.to_string())?;
+    let progress = Progress::new();
     let is_ubx = args
         .input
         .extension()
@@ -476,14 +483,22 @@ pub fn spp(args: SppArgs) -> Result<(), String> {
             ionosphere: args.ionosphere,
             out: temp.clone(),
         };
-        convert_files(&convert.options()?, &temp).map_err(|e| e.to_string())?;
+        convert_files(&convert.options()?, &temp, &mut |phase, f| {
+            progress.fraction(&format!("spp, {phase}"), f)
+        })
+        .map_err(|e| e.to_string())?;
         temp.clone()
     } else {
         args.input.clone()
     };
     let inputs = bag_spp_inputs(&bag, Some(TRUTH_TOPIC.to_owned())).map_err(|e| e.to_string());
     let per_constellation = args.clock == ClockArg::PerConstellation;
-    let report = inputs.map(|inputs| run_spp_with(inputs, &config, per_constellation));
+    let report = inputs.map(|inputs| {
+        run_spp_with(inputs, &config, per_constellation, |f| {
+            progress.fraction("spp", f)
+        })
+    });
+    progress.end();
     if is_ubx {
         // Best effort: a temporary file left behind is harmless.
         let _ = std::fs::remove_file(&temp);
@@ -542,8 +557,12 @@ pub fn spp_rinex(args: SppRinexArgs) -> Result<(), String> {
     } else {
         RinexSppOptions::rtklib_single_brdc_saas()
     };
-    let s = solve_rinex_files(&args.obs, &args.nav, &args.out_csv, &options)
-        .map_err(|e| e.to_string())?;
+    let progress = Progress::new();
+    let s = solve_rinex_files(&args.obs, &args.nav, &args.out_csv, &options, |f| {
+        progress.fraction("spp-rinex", f)
+    });
+    progress.end();
+    let s = s.map_err(|e| e.to_string())?;
     eprintln!(
         "wrote {}: {} of {} epochs solved ({} malformed lines, {} event records skipped)",
         args.out_csv.display(),

@@ -1,7 +1,6 @@
 //! Runs several filter configurations over the same bag, in parallel, and tabulates their
 //! errors.
 
-use std::io::{IsTerminal, Write};
 use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
@@ -13,6 +12,7 @@ use crate::config::Config;
 use crate::eval::ErrorSummary;
 
 use super::bag_run::BagRunner;
+use super::progress;
 use super::scoring::SessionReport;
 
 /// Scoring interval of the comparisons (s): every reference sample of a simulated bag
@@ -33,7 +33,8 @@ pub struct NamedConfig {
 /// the next configuration and streaming the bag itself through the ROS adapter, as
 /// `replay` does: memory stays that of one replay per worker, and no worker waits for
 /// another's input. Each row's `runtime_s` is the wall time of its own run. Progress goes
-/// to stderr: a live line on a terminal, a line per finished configuration otherwise.
+/// to stderr ([`progress::Progress`]): a live line on a terminal; otherwise a line every
+/// few seconds and one per finished configuration.
 pub fn compare_bag(
     bag: &Path,
     configs: &[NamedConfig],
@@ -107,7 +108,7 @@ struct Progress<'a> {
     /// Fraction done of each run; None before it starts.
     done: Mutex<Vec<Option<f64>>>,
     finished: AtomicUsize,
-    live: bool,
+    line: progress::Progress,
 }
 
 impl<'a> Progress<'a> {
@@ -116,7 +117,7 @@ impl<'a> Progress<'a> {
             configs,
             done: Mutex::new(vec![None; configs.len()]),
             finished: AtomicUsize::new(0),
-            live: std::io::stderr().is_terminal(),
+            line: progress::Progress::new(),
         }
     }
 
@@ -125,7 +126,7 @@ impl<'a> Progress<'a> {
             return;
         };
         done[k] = Some(fraction);
-        if self.live {
+        self.line.show(|| {
             let running: Vec<String> = done
                 .iter()
                 .zip(self.configs)
@@ -133,20 +134,17 @@ impl<'a> Progress<'a> {
                 .map(|(f, c)| format!("{} {:.0} %", c.name, f.unwrap_or(0.0) * 100.0))
                 .collect();
             let finished = self.finished.load(Ordering::Relaxed);
-            let mut err = std::io::stderr().lock();
-            let _ = write!(
-                err,
-                "\r\x1b[Kcompare: {finished}/{} done; {}",
+            format!(
+                "compare: {finished}/{} done; {}",
                 self.configs.len(),
                 running.join(", ")
-            );
-            let _ = err.flush();
-        }
+            )
+        });
     }
 
     fn finished(&self, k: usize) {
         let n = self.finished.fetch_add(1, Ordering::Relaxed) + 1;
-        if !self.live {
+        if !self.line.is_live() {
             eprintln!(
                 "compare: {} done ({n}/{})",
                 self.configs[k].name,
@@ -156,9 +154,7 @@ impl<'a> Progress<'a> {
     }
 
     fn end(&self) {
-        if self.live {
-            eprint!("\r\x1b[K");
-        }
+        self.line.end();
     }
 }
 

@@ -229,8 +229,21 @@ fn stamp_of(gpst_s: f64, leap_s: f64) -> Result<(Time, u64), ConvertError> {
     Ok((stamp, sec * 1_000_000_000 + u64::from(stamp.nanosec)))
 }
 
+/// Called with the phase of a conversion and the fraction of it done.
+pub type ConvertProgress<'a> = &'a mut dyn FnMut(&'static str, f64);
+
 /// Converts the inputs of `options` into the bag `out`.
 pub fn convert(options: &ConvertOptions, out: &Path) -> Result<ConvertSummary, ConvertError> {
+    convert_with_progress(options, out, &mut |_, _| {})
+}
+
+/// [`convert`], telling `progress` how far its longer phases are: building the GNSS
+/// epochs (or reading a robot bag) and writing the bag.
+pub fn convert_with_progress(
+    options: &ConvertOptions,
+    out: &Path,
+    progress: ConvertProgress,
+) -> Result<ConvertSummary, ConvertError> {
     let mut summary = ConvertSummary::default();
     let mut items: Vec<(u64, Item)> = Vec::new();
     let (gnss_path, log) = match &options.gnss {
@@ -243,11 +256,11 @@ pub fn convert(options: &ConvertOptions, out: &Path) -> Result<ConvertSummary, C
                 .rev()
                 .find(|r| r.leap_s_valid)
                 .map(|r| r.leap_s);
-            gnss_items(&log, options, &mut items, &mut summary)?;
+            gnss_items(&log, options, &mut items, &mut summary, progress)?;
             (path, Some(log))
         }
         GnssSource::Rinex { obs, nav } => {
-            rinex_items(obs, nav, options, &mut items, &mut summary)?;
+            rinex_items(obs, nav, options, &mut items, &mut summary, progress)?;
             (obs, None)
         }
         GnssSource::Bag {
@@ -260,7 +273,7 @@ pub fn convert(options: &ConvertOptions, out: &Path) -> Result<ConvertSummary, C
                 host_latency_s: *host_latency_s,
                 ..adapter_params(options)?
             };
-            robot_bag_items(bag, params, &mut items, &mut summary)?;
+            robot_bag_items(bag, params, &mut items, &mut summary, progress)?;
             (&bag.path, None)
         }
     };
@@ -316,11 +329,16 @@ pub fn convert(options: &ConvertOptions, out: &Path) -> Result<ConvertSummary, C
         items.first().map_or(0.0, |(ns, _)| *ns as f64 * 1e-9),
         items.last().map_or(0.0, |(ns, _)| *ns as f64 * 1e-9),
     );
-    write_bag(out, &items, !truth.is_empty())?;
+    write_bag(out, &items, !truth.is_empty(), progress)?;
     Ok(summary)
 }
 
-fn write_bag(out: &Path, items: &[(u64, Item)], truth: bool) -> Result<(), ConvertError> {
+fn write_bag(
+    out: &Path,
+    items: &[(u64, Item)],
+    truth: bool,
+    progress: ConvertProgress,
+) -> Result<(), ConvertError> {
     let mut bag = BagWriter::create(out)?;
     bag.add_topic::<Imu>(IMU_TOPIC)?;
     bag.add_topic::<GnssMeasurements>(GNSS_TOPIC)?;
@@ -329,7 +347,8 @@ fn write_bag(out: &Path, items: &[(u64, Item)], truth: bool) -> Result<(), Conve
         bag.add_topic::<NavSatFix>(TRUTH_DATUM_TOPIC)?;
         bag.add_topic::<DiagnosticArray>(TRUTH_ENVIRONMENT_TOPIC)?;
     }
-    for (ns, item) in items {
+    for (k, (ns, item)) in items.iter().enumerate() {
+        progress("writing the bag", k as f64 / items.len() as f64);
         match item {
             Item::Imu(m) => bag.write(IMU_TOPIC, m.as_ref(), *ns)?,
             Item::Gnss(m) => bag.write(GNSS_TOPIC, m.as_ref(), *ns)?,
@@ -347,8 +366,10 @@ fn gnss_items(
     options: &ConvertOptions,
     items: &mut Vec<(u64, Item)>,
     summary: &mut ConvertSummary,
+    progress: ConvertProgress,
 ) -> Result<(), ConvertError> {
     for (k, raw) in log.rawx.iter().enumerate() {
+        progress("building the GNSS epochs", k as f64 / log.rawx.len() as f64);
         let built = match options.ephemeris {
             EphemerisMode::WholeLog => {
                 build_epoch_with(raw, &log.store, log.klobuchar, options.ionosphere)
@@ -393,9 +414,10 @@ fn robot_bag_items(
     params: UbxAdapterParams,
     items: &mut Vec<(u64, Item)>,
     summary: &mut ConvertSummary,
+    progress: ConvertProgress,
 ) -> Result<(), ConvertError> {
-    let (messages, read) =
-        read_robot_bag(bag, params).map_err(|source| ConvertError::RobotBag {
+    let (messages, read) = read_robot_bag(bag, params, |f| progress("reading the robot bag", f))
+        .map_err(|source| ConvertError::RobotBag {
             path: bag.path.display().to_string(),
             source: Box::new(source),
         })?;
@@ -431,6 +453,7 @@ fn rinex_items(
     options: &ConvertOptions,
     items: &mut Vec<(u64, Item)>,
     summary: &mut ConvertSummary,
+    progress: ConvertProgress,
 ) -> Result<(), ConvertError> {
     if options.ionosphere == IonosphereMode::IonoFree {
         return Err(ConvertError::RinexIonoFree);
@@ -447,7 +470,11 @@ fn rinex_items(
         store.insert(*eph);
     }
     summary.klobuchar = nav.klobuchar.is_some();
-    for epoch in &obs.epochs {
+    for (k, epoch) in obs.epochs.iter().enumerate() {
+        progress(
+            "building the GNSS epochs",
+            k as f64 / obs.epochs.len() as f64,
+        );
         let mut built = build_rinex_epoch(epoch, &store, nav.klobuchar);
         if options.ionosphere == IonosphereMode::None {
             for sat in &mut built.epoch.satellites {

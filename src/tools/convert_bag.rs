@@ -133,10 +133,12 @@ fn has_messages<T: RosMessage>(topics: &[TopicInfo], topic: &str) -> Result<bool
     }
 }
 
-/// Reads `bag` through a [`UbxAdapter`] with `params`.
+/// Reads `bag` through a [`UbxAdapter`] with `params`; `progress` is called with the
+/// fraction of the bag's messages read.
 pub fn read_robot_bag(
     bag: &RobotBag,
     params: UbxAdapterParams,
+    mut progress: impl FnMut(f64),
 ) -> Result<(RobotBagMessages, RobotBagSummary), RobotBagError> {
     let mut adapter = UbxAdapter::new(params)?;
     let reader = BagReader::open(&bag.path)?;
@@ -156,7 +158,9 @@ pub fn read_robot_bag(
     let mut out = RobotBagMessages::default();
     let (mut imu_skipped, mut read_errors) = (0, 0);
     let mut last_s = 0.0;
-    for item in reader.messages()? {
+    let total: u64 = reader.topics().iter().map(|t| t.message_count).sum();
+    for (k, item) in reader.messages()?.enumerate() {
+        progress(k as f64 / total.max(1) as f64);
         let Ok(msg) = item else {
             read_errors += 1;
             continue;

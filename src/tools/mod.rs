@@ -11,6 +11,7 @@ pub mod convert;
 pub mod convert_bag;
 pub mod imu_csv;
 pub mod plots;
+pub mod progress;
 pub mod replay;
 pub mod rtklib_pos;
 pub mod scenario_inputs;

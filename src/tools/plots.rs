@@ -82,7 +82,13 @@ pub struct EnvironmentSpan {
 }
 
 /// Writes the figures into `dir` (created if needed); returns the files written.
-pub fn write_plots(dir: &Path, runs: &[FilterRun]) -> Result<Vec<PathBuf>, PlotError> {
+///
+/// `progress` is called before each file with the fraction of the files written.
+pub fn write_plots(
+    dir: &Path,
+    runs: &[FilterRun],
+    mut progress: impl FnMut(f64),
+) -> Result<Vec<PathBuf>, PlotError> {
     register_font()?;
     std::fs::create_dir_all(dir).map_err(|e| PlotError::Io {
         path: dir.display().to_string(),
@@ -123,7 +129,10 @@ pub fn write_plots(dir: &Path, runs: &[FilterRun]) -> Result<Vec<PathBuf>, PlotE
         noise_figure(runs),
     ];
     let mut written = Vec::new();
+    // Two files (PNG and SVG) per figure.
+    let files = 2 * figures.iter().flatten().count();
     for figure in figures.iter().flatten() {
+        progress(written.len() as f64 / files as f64);
         let png = dir.join(format!("{}.png", figure.file_stem));
         let drawn = draw_figure(
             &BitMapBackend::new(&png, FIGURE_SIZE).into_drawing_area(),
@@ -135,6 +144,7 @@ pub fn write_plots(dir: &Path, runs: &[FilterRun]) -> Result<Vec<PathBuf>, PlotE
             reason,
         })?;
         written.push(png);
+        progress(written.len() as f64 / files as f64);
         let svg = dir.join(format!("{}.svg", figure.file_stem));
         let drawn = draw_figure(
             &SVGBackend::new(&svg, FIGURE_SIZE).into_drawing_area(),

@@ -9,7 +9,7 @@ use std::path::Path;
 use crate::config::Config;
 use crate::earth::Llh;
 use crate::eval::{TruthSample, TruthTrack};
-use crate::ros::adapter::{OutputFrames, Published, RosAdapter};
+use crate::ros::adapter::{OutputFrames, Published, RosAdapter, TfMode};
 use crate::ros::bag::{BagError, BagReader, BagWriteOptions, BagWriter, ChunkCompression};
 use crate::ros::msg::{Imu, NavSatFix, NoiseEstimates, Odometry, RosMessage, TFMessage, Time};
 
@@ -21,7 +21,9 @@ use super::scoring::Scorer;
 pub const ODOMETRY_TOPIC: &str = "/odometry";
 pub const FIX_OUT_TOPIC: &str = "/fix/filtered";
 pub const NOISE_TOPIC: &str = "/noise_estimates";
-/// Only with `publish_tf`.
+/// Written with `publish_tf` in `tf_mode` `map_to_base_link` or `map_to_odom`; in
+/// `map_to_odom` also read from the input bag (the base controller's `odom → base`), as
+/// the node then subscribes it.
 pub const TF_TOPIC: &str = "/tf";
 
 /// Why a replay failed (partial results are kept in the files written so far).
@@ -69,8 +71,8 @@ pub struct ReplayOptions<'a> {
     pub csv: Option<&'a Path>,
     /// Scores at most this often (s); 0 scores every solution that has a reference.
     pub score_interval_s: f64,
-    /// The frames of the written messages (the node's `map_frame`, `base_frame`,
-    /// `publish_tf`).
+    /// The frames of the written messages and the TF (the node's `map_frame`,
+    /// `base_frame`, `odom_frame`, `publish_tf`, `tf_mode`).
     pub frames: OutputFrames,
     /// Compression of the output bag's chunks.
     pub compression: ChunkCompression,
@@ -101,6 +103,9 @@ pub fn replay(
             Some(track)
         }
     };
+    if options.frames.published_tf() == TfMode::MapToOdom {
+        topics.tf = Some(TF_TOPIC.to_owned());
+    }
     let has_imu = reader
         .topics()
         .iter()
@@ -151,7 +156,7 @@ impl ReplayOutputs {
                     ..BagWriteOptions::default()
                 };
                 let mut w = BagWriter::create_with_options(p, bag_options)?;
-                if options.frames.publish_tf {
+                if options.frames.published_tf() != TfMode::None {
                     w.add_topic::<TFMessage>(TF_TOPIC)?;
                 }
                 w.add_topic::<Odometry>(ODOMETRY_TOPIC)?;

@@ -121,6 +121,17 @@ pub fn simulate_with(
     out: &Path,
     options: SimulateOptions,
 ) -> Result<SimulateSummary, SimulateError> {
+    simulate_with_progress(scenario, out, options, |_| {})
+}
+
+/// [`simulate_with`], calling `progress` with the fraction of the scenario's time written
+/// at each reference sample.
+pub fn simulate_with_progress(
+    scenario: &Scenario,
+    out: &Path,
+    options: SimulateOptions,
+    mut progress: impl FnMut(f64),
+) -> Result<SimulateSummary, SimulateError> {
     let mut bag = BagWriter::create(out)?;
     bag.add_topic::<Imu>(IMU_TOPIC)?;
     bag.add_topic::<GnssMeasurements>(GNSS_TOPIC)?;
@@ -161,6 +172,7 @@ pub fn simulate_with(
                 let odom = outbound::odometry(&solution, &origin, st, "map", "base_link");
                 bag.write(TRUTH_TOPIC, &odom, ns)?;
                 summary.truth += 1;
+                progress(t / scenario.duration_s());
             }
             SimEvent::Environment { name, .. } => {
                 bag.write(TRUTH_ENVIRONMENT_TOPIC, &environment(name, st), ns)?;

@@ -15,7 +15,7 @@ use thiserror::Error;
 
 use crate::gnss::rinex_nav::{parse_rinex_nav, RinexNavError};
 use crate::gnss::rinex_obs::{parse_rinex_obs, RinexObsError};
-use crate::gnss::rinex_spp::{solve_rinex_spp, RinexSppEpoch, RinexSppOptions};
+use crate::gnss::rinex_spp::{solve_rinex_spp_with_progress, RinexSppEpoch, RinexSppOptions};
 use crate::gnss::spp::SppError;
 
 /// Why the tool could not run.
@@ -54,13 +54,14 @@ pub struct SppRinexSummary {
     pub skipped_records: usize,
 }
 
-/// Reads `obs_path` and `nav_path`, solves every epoch with `options` and writes the
-/// CSV to `out_csv`.
+/// Reads `obs_path` and `nav_path`, solves every epoch with `options` (`progress` is
+/// called with the fraction of the epochs solved) and writes the CSV to `out_csv`.
 pub fn spp_rinex(
     obs_path: &Path,
     nav_path: &Path,
     out_csv: &Path,
     options: &RinexSppOptions,
+    progress: impl FnMut(f64),
 ) -> Result<SppRinexSummary, SppRinexError> {
     let read = |path: &Path| {
         std::fs::read_to_string(path).map_err(|source| SppRinexError::Io {
@@ -76,7 +77,7 @@ pub fn spp_rinex(
         path: nav_path.to_path_buf(),
         source,
     })?;
-    let solved = solve_rinex_spp(&obs, &nav, options);
+    let solved = solve_rinex_spp_with_progress(&obs, &nav, options, progress);
     let io = |source| SppRinexError::Io {
         path: out_csv.to_path_buf(),
         source,

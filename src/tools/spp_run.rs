@@ -126,15 +126,17 @@ pub fn bag_spp_inputs(
 /// (one receiver clock, as the filter) and scores the solutions against the reference
 /// samples of `inputs`.
 pub fn run_spp(inputs: impl Iterator<Item = SessionInput>, config: &Config) -> SppReport {
-    run_spp_with(inputs, config, false)
+    run_spp_with(inputs, config, false, |_| {})
 }
 
 /// [`run_spp`] with one receiver clock per constellation when `clock_per_constellation`
-/// (see [`SppConfig::clock_per_constellation`]).
+/// (see [`SppConfig::clock_per_constellation`]), calling `progress` with the fraction of
+/// the epochs solved.
 pub fn run_spp_with(
     inputs: impl Iterator<Item = SessionInput>,
     config: &Config,
     clock_per_constellation: bool,
+    mut progress: impl FnMut(f64),
 ) -> SppReport {
     let settings = SppConfig {
         clock_per_constellation,
@@ -157,7 +159,9 @@ pub fn run_spp_with(
     }
     let track = TruthTrack::new(truth, MAX_TRUTH_GAP_S);
     let mut report = SppReport::default();
-    for mut epoch in epochs {
+    let total = epochs.len();
+    for (k, mut epoch) in epochs.into_iter().enumerate() {
+        progress(k as f64 / total as f64);
         epoch
             .satellites
             .retain(|s| config.gnss.constellations.contains(&s.sat.constellation));

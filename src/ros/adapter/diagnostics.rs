@@ -2,7 +2,7 @@
 
 use crate::ros::msg::{DiagnosticArray, DiagnosticStatus, Header, KeyValue, Time};
 
-use super::{RosAdapter, TfMode};
+use super::RosAdapter;
 
 impl RosAdapter {
     /// The /diagnostics report at `stamp`: input counts, constraint updates by kind,
@@ -42,11 +42,11 @@ impl RosAdapter {
                 values.push(key_value(&key, n.to_string()));
             }
         }
-        if self.outputs.frames().published_tf() == TfMode::MapToOdom {
-            let odom = &self.outputs.odom;
-            values.push(key_value("odom_tf_received", odom.heard.to_string()));
+        if let Some(odom) = self.odom_tf_counts() {
+            values.push(key_value("odom_tf_received", odom.received.to_string()));
             values.push(key_value("odom_tf_unusable", odom.unusable.to_string()));
-            values.push(key_value("map_to_odom_missing", odom.missing.to_string()));
+            let missing = odom.map_to_odom_missing.to_string();
+            values.push(key_value("map_to_odom_missing", missing));
         }
         values.extend(self.engine.counters().iter().map(|(reason, n)| KeyValue {
             key: format!("rejected_{}", reason.name()),

@@ -48,7 +48,7 @@ use crate::ros::log_limit::LogLimiter;
 pub use counts::{Input, InputCounts};
 use frame_lock::FrameLock;
 pub use inputs::InputMessage;
-pub use odom_tf::TfMode;
+pub use odom_tf::{OdomTfCounts, TfMode};
 pub use outputs::{OutputFrames, Published, PublishedEpoch, PublishedSolution, SolutionMessages};
 pub use phase_counts::PhaseCounts;
 use stamp_book::StampBook;
@@ -130,6 +130,13 @@ impl RosAdapter {
     /// What the carrier-phase updates did with the phase changes (`gnss.tdcp`).
     pub fn phase_counts(&self) -> &PhaseCounts {
         &self.phases
+    }
+
+    /// What became of the base controller's transforms, in `tf_mode` `map_to_odom` only
+    /// (with `publish_tf`).
+    pub fn odom_tf_counts(&self) -> Option<OdomTfCounts> {
+        (self.outputs.frames().published_tf() == TfMode::MapToOdom)
+            .then(|| self.outputs.odom.counts())
     }
 
     /// Velocities dropped for want of a fix of their stamp.

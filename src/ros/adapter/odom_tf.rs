@@ -83,6 +83,18 @@ fn isometry(t: &Vector3, q: &Quaternion) -> Option<Isometry3<f64>> {
     ))
 }
 
+/// What became of the base controller's transforms in `map_to_odom` mode (on the node's
+/// /diagnostics as `odom_tf_received`, `odom_tf_unusable` and `map_to_odom_missing`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct OdomTfCounts {
+    /// `odom → base` transforms taken.
+    pub received: u64,
+    /// `odom → base` transforms with a non-finite value or no rotation: dropped.
+    pub unusable: u64,
+    /// Odometry messages without a `map → odom` (no `odom → base` near their stamp).
+    pub map_to_odom_missing: u64,
+}
+
 /// The recent `odom_frame → base_frame` transforms of the base controller, by stamp.
 #[derive(Debug, Clone)]
 pub(super) struct OdomHistory {
@@ -107,6 +119,14 @@ impl OdomHistory {
             heard: 0,
             unusable: 0,
             missing: 0,
+        }
+    }
+
+    pub(super) fn counts(&self) -> OdomTfCounts {
+        OdomTfCounts {
+            received: self.heard,
+            unusable: self.unusable,
+            map_to_odom_missing: self.missing,
         }
     }
 

@@ -435,17 +435,28 @@ pub fn resolved(args: &NodeArgs) -> Result<Vec<Assignment>, ParamsError> {
     Ok(overrides(&args.parameter_sources, &fqn, &args.node_name)?.for_node(&fqn))
 }
 
-/// The configuration of `replay`, `compare` and `spp` from their `--params` files, read
-/// in order (a later value wins) for the node `/gnss_ins_node` (as the node started with
-/// its default name reads them). The node's own parameters are accepted and ignored.
-pub fn config_from_files(paths: &[PathBuf]) -> Result<Config, ParamsError> {
+/// The values that parameter files read in order (a later value wins) give the node
+/// `/gnss_ins_node` (as the node started with its default name reads them).
+fn values_from_files(paths: &[PathBuf]) -> Result<Vec<Assignment>, ParamsError> {
     let sources: Vec<ParameterSource> = paths.iter().cloned().map(ParameterSource::File).collect();
     let fqn = format!("/{DEFAULT_NODE_NAME}");
-    let values = overrides(&sources, &fqn, DEFAULT_NODE_NAME)?.for_node(&fqn);
-    let core = values
+    Ok(overrides(&sources, &fqn, DEFAULT_NODE_NAME)?.for_node(&fqn))
+}
+
+/// The configuration of `compare` and `spp` from their `--params` files (see
+/// [`values_from_files`]). The node's own parameters are accepted and ignored.
+pub fn config_from_files(paths: &[PathBuf]) -> Result<Config, ParamsError> {
+    let core = values_from_files(paths)?
         .into_iter()
         .filter(|a| NodeParameter::named(&a.name).is_none());
     Ok(Config::default().with(core)?)
+}
+
+/// What `replay`'s `--params` files give the node (see [`values_from_files`]): the
+/// configuration and the node's own parameters, checked as the node checks them, so that
+/// `replay` frames its outputs and publishes the TF as the node started with these files.
+pub fn node_params_from_files(paths: &[PathBuf]) -> Result<NodeParams, ParamsError> {
+    node_params_from(&values_from_files(paths)?)
 }
 
 #[cfg(test)]
