@@ -268,7 +268,12 @@ pub fn node_params_from(values: &[Assignment]) -> Result<NodeParams, ParamsError
             "must differ from map_frame",
         ));
     }
-    if frames.odom_frame == frames.map_frame || frames.odom_frame == frames.base_frame {
+    // The odom frame is used only in map_to_odom: a robot without a map that names its
+    // fused frame `odom` (map_frame: odom) is not refused for the unused default.
+    let odom_used = frames.published_tf() == TfMode::MapToOdom;
+    if odom_used
+        && (frames.odom_frame == frames.map_frame || frames.odom_frame == frames.base_frame)
+    {
         return Err(clash(
             ODOM_FRAME,
             &frames.odom_frame,
@@ -698,8 +703,6 @@ mod tests {
             "base_frame:=''",
             "map_frame:=12",
             "base_frame:=map",
-            "odom_frame:=base_link",
-            "odom_frame:=map",
             "tf_mode:=map_to_odometry",
             "tf_mode:=1",
         ] {
@@ -709,5 +712,16 @@ mod tests {
                 "{bad}: {e:?}"
             );
         }
+        // The odom frame must differ from the others where it is used.
+        for bad in ["odom_frame:=base_link", "odom_frame:=odom_enu"] {
+            let e = load_with(&[&file], &["-p", "tf_mode:=map_to_odom", "-p", bad]);
+            assert!(
+                matches!(e, Err(ParamsError::NodeParameter { .. })),
+                "{bad}: {e:?}"
+            );
+        }
+        // Elsewhere it is unused: a map frame named `odom` is fine.
+        let p = load_with(&[&file], &["-p", "map_frame:=odom"]).unwrap();
+        assert_eq!(p.frames.map_frame, "odom");
     }
 }
