@@ -386,9 +386,10 @@ parameter_table! {
         // simulated open-sky drive the slow part (20 % of the ionosphere left by the
         // Klobuchar model) is 0.9-2.4 m per satellite and constant over minutes, the
         // estimators find the white part (0.5-2 m) within 10 %, and 1.5 m at the zenith
-        // is the smallest value of 0.3-1.0 m tried that puts the NEES of srmakf, ermakf
-        // and residual_akf inside its 95 % bounds on over 90 % of the epochs
-        // (docs/results.md).
+        // is the smallest of the values tried (0.9-3 m) that puts the NEES of srmakf,
+        // ermakf and residual_akf inside its 95 % bounds on over 90 % of the epochs
+        // (docs/results.md). An addition rather than max(R, floor): the estimate is of
+        // the white part, and the variances of independent parts add.
         pseudorange_slow_sigma_m: f64 = 1.5,
             unit "m", range Range::Within(Interval::closed(0.0, 1e3)), at_start;
         /// Longest gap between two epochs of a satellite across which a mutual difference
