@@ -130,6 +130,7 @@ const EVERY_KEY_CHANGED: &str = "
       pseudorange_sigma_max_m: 90.0
       pseudorange_rate_sigma_min_mps: 0.03
       pseudorange_rate_sigma_max_mps: 5.0
+      pseudorange_slow_sigma_m: 0.8
       max_epoch_gap_s: 3.0
     robust:
       adaptive_factor_function: three_segment

@@ -45,6 +45,10 @@ pub struct ScalarMeasurement {
     pub row: Row,
     /// The variance of the fixed σ model (gnss.*), used until an estimate is trusted.
     pub r_nominal: f64,
+    /// The variance of the slow error part that the estimators do not see
+    /// (`adaptive.pseudorange_slow_sigma_m` by elevation; 0 for rates), added to an
+    /// estimate.
+    pub r_slow: f64,
 }
 
 /// A strategy's answer for one scalar measurement.
@@ -102,9 +106,27 @@ impl NoiseModel {
         }
     }
 
-    /// The variances of an epoch's measurements, in the same order. With `learn` false
-    /// (measurements re-applied after a roll-back) the estimators are only read.
+    /// The variances of an epoch's measurements, in the same order: an estimate plus the
+    /// slow part its estimator cannot see (`ScalarMeasurement::r_slow`), or the nominal
+    /// variance. With `learn` false (measurements re-applied after a roll-back) the
+    /// estimators are only read.
     pub fn variances(
+        &mut self,
+        t_s: f64,
+        rows: &[ScalarMeasurement],
+        learn: bool,
+    ) -> Vec<NoiseVerdict> {
+        let mut verdicts = self.strategy_variances(t_s, rows, learn);
+        for (verdict, row) in verdicts.iter_mut().zip(rows) {
+            if verdict.estimated {
+                verdict.r += row.r_slow;
+            }
+        }
+        verdicts
+    }
+
+    /// The strategy's own variances (the estimate, without the slow part).
+    fn strategy_variances(
         &mut self,
         t_s: f64,
         rows: &[ScalarMeasurement],

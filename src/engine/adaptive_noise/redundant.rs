@@ -294,6 +294,7 @@ mod tests {
                         hph: 1.0,
                         row,
                         r_nominal: 9.0,
+                        r_slow: 0.0,
                     }
                 })
                 .collect();

@@ -243,6 +243,7 @@ mod tests {
             hph: 1.0,
             row: crate::filter::measurement_rows::Row::zeros(),
             r_nominal: 9.0,
+            r_slow: 0.0,
         };
         for k in 0..4 {
             noise.after_update(f64::from(k), &[row], &[8.0], &[0.5]);

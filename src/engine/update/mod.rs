@@ -170,6 +170,7 @@ impl<M: MeasurementModel> Step<'_, M> {
                 hph: row_variance(&lin.rows[i], &state.p),
                 row: lin.rows[i],
                 r_nominal: c.r_nominal,
+                r_slow: c.r_slow,
             })
             .collect();
         let verdicts = self.adaptation.noise.variances(t_s, &scalars, self.learn);

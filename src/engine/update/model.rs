@@ -85,4 +85,7 @@ pub struct NoiseChannel {
     pub observable: Observable,
     /// The variance of the fixed σ model.
     pub r_nominal: f64,
+    /// The variance of the slow error part added to an estimated variance
+    /// (`adaptive.pseudorange_slow_sigma_m`; 0 for rates).
+    pub r_slow: f64,
 }

@@ -109,6 +109,11 @@ impl MeasurementModel for Pseudoranges<'_> {
         let rx_pos = geo.antenna_ecef_m(&state.nav.p);
         let rx_vel = geo.antenna_velocity_ecef_mps(&state.nav.v_n);
         let sigmas = sigma_model(config);
+        let slow_sigmas = SigmaModel {
+            pseudorange_zenith_m: config.adaptive.pseudorange_slow_sigma_m,
+            prefer_reported: false,
+            ..sigmas
+        };
         let capacity = 2 * self.epoch.satellites.len();
         let mut rows = Vec::with_capacity(capacity);
         let mut measured = Vec::with_capacity(capacity);
@@ -123,7 +128,7 @@ impl MeasurementModel for Pseudoranges<'_> {
                     sat.elevation_rad = pred.elevation_rad;
                     let sat_index = report.satellites.len();
                     let el = Some(pred.elevation_rad);
-                    let mut push = |observable, row, value, prediction, sigma: f64| {
+                    let mut push = |observable, row, value, prediction, sigma: f64, slow: f64| {
                         rows.push(row);
                         measured.push(value);
                         predicted.push(prediction);
@@ -131,6 +136,7 @@ impl MeasurementModel for Pseudoranges<'_> {
                             sat: obs.sat,
                             observable,
                             r_nominal: sigma.powi(2),
+                            r_slow: slow.powi(2),
                         });
                         self.sources.push(RowSource {
                             sat_index,
@@ -144,6 +150,7 @@ impl MeasurementModel for Pseudoranges<'_> {
                         obs.pseudorange_m,
                         pred.pseudorange_m,
                         sigmas.pseudorange_sigma_m(obs, el),
+                        slow_sigmas.pseudorange_sigma_m(obs, el),
                     );
                     if let (true, Some(rate)) =
                         (config.gnss.use_pseudorange_rate, obs.pseudorange_rate_mps)
@@ -154,6 +161,7 @@ impl MeasurementModel for Pseudoranges<'_> {
                             rate,
                             pred.pseudorange_rate_mps,
                             sigmas.pseudorange_rate_sigma_mps(obs, el),
+                            0.0,
                         );
                     }
                 }
