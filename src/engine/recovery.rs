@@ -35,7 +35,7 @@ impl Engine {
         let gnss = match m {
             Measurement::Fix(f) => Some((f.position, position_covariance(f, &self.config))),
             Measurement::Gnss(e) => single_point_if_gated(e, report, prior, &self.config),
-            Measurement::WheelSpeed(_) => None,
+            Measurement::WheelSpeed(_) | Measurement::BaselineHeading(_) => None,
         };
         let disagreement = gnss.map(|(position, covariance_enu_m2)| {
             Disagreement::of(prior, &position, &covariance_enu_m2, &self.config)
