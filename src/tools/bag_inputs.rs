@@ -14,7 +14,7 @@ use crate::ros::cdr;
 use crate::ros::convert::time_to_seconds;
 use crate::ros::msg::{
     DiagnosticArray, GnssMeasurements, Imu, NavSatFix, NoiseEstimates, Odometry, RosMessage,
-    TwistWithCovarianceStamped,
+    TwistWithCovarianceStamped, UbxNavRelPosNed,
 };
 
 use super::scoring::Reference;
@@ -35,6 +35,9 @@ pub struct BagTopics {
     /// nav_msgs/Odometry of the base controller, whose forward speed is fed with
     /// `wheel_odometry.enabled`.
     pub wheel_odometry: String,
+    /// ublox_ubx_msgs/UBXNavRelPosNED of a moving-base pair, whose baseline heading is fed
+    /// with `dual_antenna.enabled`.
+    pub rel_pos_ned: String,
     /// nav_msgs/Odometry reference in an ENU frame at `truth_datum` (None: no reference).
     pub truth: Option<String>,
     pub truth_datum: String,
@@ -51,6 +54,7 @@ impl Default for BagTopics {
             fix: FIX_TOPIC.to_owned(),
             velocity: VELOCITY_TOPIC.to_owned(),
             wheel_odometry: WHEEL_ODOMETRY_TOPIC.to_owned(),
+            rel_pos_ned: REL_POS_NED_TOPIC.to_owned(),
             truth: Some(TRUTH_TOPIC.to_owned()),
             truth_datum: TRUTH_DATUM_TOPIC.to_owned(),
             truth_noise: TRUTH_NOISE_TOPIC.to_owned(),
@@ -77,6 +81,7 @@ impl Role {
             Role::Input(Input::Fix) | Role::TruthDatum => NavSatFix::TYPE_NAME,
             Role::Input(Input::Velocity) => TwistWithCovarianceStamped::TYPE_NAME,
             Role::Input(Input::WheelOdometry) | Role::Truth => Odometry::TYPE_NAME,
+            Role::Input(Input::RelPosNed) => UbxNavRelPosNed::TYPE_NAME,
             Role::TruthNoise => NoiseEstimates::TYPE_NAME,
             Role::Environment => DiagnosticArray::TYPE_NAME,
         }
@@ -96,6 +101,8 @@ impl BagTopics {
             Some(Role::Input(Input::Velocity))
         } else if topic == self.wheel_odometry {
             Some(Role::Input(Input::WheelOdometry))
+        } else if topic == self.rel_pos_ned {
+            Some(Role::Input(Input::RelPosNed))
         } else if topic == self.truth_datum {
             Some(Role::TruthDatum)
         } else if self.truth.as_deref() == Some(topic) {
@@ -255,6 +262,7 @@ impl BagInputs {
             Role::Input(Input::WheelOdometry) => {
                 InputMessage::WheelOdometry(Box::new(decode(data)?))
             }
+            Role::Input(Input::RelPosNed) => InputMessage::RelPosNed(Box::new(decode(data)?)),
             Role::TruthDatum => {
                 let msg: NavSatFix = decode(data)?;
                 self.datum = Some(Llh::from_degrees(msg.latitude, msg.longitude, msg.altitude));

@@ -13,6 +13,9 @@ pub enum Input {
     Velocity,
     /// `wheel/odometry`: nav_msgs/Odometry of the base controller (its forward speed).
     WheelOdometry,
+    /// `ubx_nav_rel_pos_ned`: ublox_ubx_msgs/UBXNavRelPosNED of a moving-base receiver
+    /// pair (its baseline heading).
+    RelPosNed,
 }
 
 impl Input {
@@ -24,6 +27,7 @@ impl Input {
             Input::Fix => "gnss/fix",
             Input::Velocity => "gnss/velocity",
             Input::WheelOdometry => "wheel/odometry",
+            Input::RelPosNed => "ubx_nav_rel_pos_ned",
         }
     }
 }
@@ -42,6 +46,8 @@ pub struct InputCounts {
     pub velocity_received: u64,
     /// nav_msgs/Odometry messages decoded on `wheel/odometry`.
     pub wheel_odometry_received: u64,
+    /// UBXNavRelPosNED messages decoded on `ubx_nav_rel_pos_ned`.
+    pub rel_pos_ned_received: u64,
     /// Velocities fed to the engine with their fix.
     pub velocity_paired: u64,
     /// Payloads that did not decode, any topic.
@@ -57,6 +63,9 @@ pub struct InputCounts {
     /// Wheel odometries with a bad stamp, a non-finite forward speed or a variance of it
     /// that is not finite or negative.
     pub unconvertible_wheel_odometry: u64,
+    /// UBXNavRelPosNED messages with a bad stamp or without a heading (no carrier-phase
+    /// solution, a flag relPosValid, relPosHeadingValid or isMoving not set).
+    pub unconvertible_rel_pos_ned: u64,
     /// Resets because the IMU time jumped backwards (several consecutive samples agreed).
     pub time_jump_resets: u64,
     /// IMU samples whose stamp was far off the time line and that no run of consecutive
@@ -76,6 +85,8 @@ pub struct InputCounts {
     pub foreign_frame_velocity: u64,
     /// Wheel odometries whose `child_frame_id` is another than the locked one.
     pub foreign_frame_wheel_odometry: u64,
+    /// UBXNavRelPosNED messages from another frame than the locked one.
+    pub foreign_frame_rel_pos_ned: u64,
     /// Times the IMU stream's learnt frame moved to another one (the locked frame went
     /// silent; the filter reset).
     pub frame_switches_imu: u64,
@@ -85,6 +96,8 @@ pub struct InputCounts {
     pub frame_switches_fix: u64,
     /// Times the wheel odometry's learnt `child_frame_id` moved to another one.
     pub frame_switches_wheel_odometry: u64,
+    /// Times the UBXNavRelPosNED stream's learnt frame moved to another one.
+    pub frame_switches_rel_pos_ned: u64,
 }
 
 impl InputCounts {
@@ -96,6 +109,7 @@ impl InputCounts {
             Input::Fix => &mut self.unconvertible_fix,
             Input::Velocity => &mut self.unconvertible_velocity,
             Input::WheelOdometry => &mut self.unconvertible_wheel_odometry,
+            Input::RelPosNed => &mut self.unconvertible_rel_pos_ned,
         }
     }
 
@@ -107,6 +121,7 @@ impl InputCounts {
             Input::Fix => &mut self.foreign_frame_fix,
             Input::Velocity => &mut self.foreign_frame_velocity,
             Input::WheelOdometry => &mut self.foreign_frame_wheel_odometry,
+            Input::RelPosNed => &mut self.foreign_frame_rel_pos_ned,
         }
     }
 
@@ -117,6 +132,7 @@ impl InputCounts {
             Input::Gnss => &mut self.frame_switches_gnss,
             Input::Fix | Input::Velocity => &mut self.frame_switches_fix,
             Input::WheelOdometry => &mut self.frame_switches_wheel_odometry,
+            Input::RelPosNed => &mut self.frame_switches_rel_pos_ned,
         }
     }
 
@@ -124,7 +140,7 @@ impl InputCounts {
     /// stamp outliers, the ones that did not convert and the ones from a foreign frame (a
     /// velocity in a foreign frame drops no message: its fix goes on alone), named as on
     /// /diagnostics.
-    pub fn dropped(&self) -> [(&'static str, u64); 10] {
+    pub fn dropped(&self) -> [(&'static str, u64); 12] {
         [
             ("imu_stamp_outliers", self.imu_stamp_outliers),
             ("unconvertible_imu", self.unconvertible_imu),
@@ -135,6 +151,7 @@ impl InputCounts {
                 "unconvertible_wheel_odometry",
                 self.unconvertible_wheel_odometry,
             ),
+            ("unconvertible_rel_pos_ned", self.unconvertible_rel_pos_ned),
             ("foreign_frame_imu", self.foreign_frame_imu),
             ("foreign_frame_gnss", self.foreign_frame_gnss),
             ("foreign_frame_fix", self.foreign_frame_fix),
@@ -142,18 +159,20 @@ impl InputCounts {
                 "foreign_frame_wheel_odometry",
                 self.foreign_frame_wheel_odometry,
             ),
+            ("foreign_frame_rel_pos_ned", self.foreign_frame_rel_pos_ned),
         ]
     }
 
     /// The counters as (name, value) in the order of the /diagnostics report; the names
     /// are the report's keys.
-    pub fn named(&self) -> [(&'static str, u64); 25] {
+    pub fn named(&self) -> [(&'static str, u64); 29] {
         [
             ("imu_received", self.imu_received),
             ("gnss_received", self.gnss_received),
             ("fix_received", self.fix_received),
             ("velocity_received", self.velocity_received),
             ("wheel_odometry_received", self.wheel_odometry_received),
+            ("rel_pos_ned_received", self.rel_pos_ned_received),
             ("velocity_paired", self.velocity_paired),
             ("undecodable", self.undecodable),
             ("unconvertible_imu", self.unconvertible_imu),
@@ -164,6 +183,7 @@ impl InputCounts {
                 "unconvertible_wheel_odometry",
                 self.unconvertible_wheel_odometry,
             ),
+            ("unconvertible_rel_pos_ned", self.unconvertible_rel_pos_ned),
             ("time_jump_resets", self.time_jump_resets),
             ("imu_stamp_outliers", self.imu_stamp_outliers),
             ("non_finite_outputs", self.non_finite_outputs),
@@ -176,12 +196,17 @@ impl InputCounts {
                 "foreign_frame_wheel_odometry",
                 self.foreign_frame_wheel_odometry,
             ),
+            ("foreign_frame_rel_pos_ned", self.foreign_frame_rel_pos_ned),
             ("frame_switches_imu", self.frame_switches_imu),
             ("frame_switches_gnss", self.frame_switches_gnss),
             ("frame_switches_fix", self.frame_switches_fix),
             (
                 "frame_switches_wheel_odometry",
                 self.frame_switches_wheel_odometry,
+            ),
+            (
+                "frame_switches_rel_pos_ned",
+                self.frame_switches_rel_pos_ned,
             ),
         ]
     }
