@@ -20,5 +20,5 @@ pub mod trajectory;
 pub use imu_errors::{ImuErrorModel, ImuErrorModelError, ImuErrorSpec};
 pub use scenario::{GnssTruth, Scenario, ScenarioEvents, SimEvent};
 pub use scenario_error::ScenarioError;
-pub use scenario_spec::ScenarioSpec;
+pub use scenario_spec::{DualAntennaSpec, ScenarioSpec};
 pub use trajectory::{Segment, Trajectory, TrajectoryError, TrajectorySpec, TruthSample};
