@@ -10,15 +10,15 @@
 mod netns_support;
 mod static_node_support;
 
-use std::time::{Duration, Instant};
-
 use adaptive_gnss_ins::engine::{BaselineHeadingReading, CarrierSolution};
 use adaptive_gnss_ins::ros::convert::seconds_to_time;
-use adaptive_gnss_ins::ros::msg::{CarrSoln, DiagnosticArray, UbxNavRelPosNed};
+use adaptive_gnss_ins::ros::msg::{CarrSoln, UbxNavRelPosNed};
 use adaptive_gnss_ins::ros::rel_pos_ned::message_of_reading;
 use netns_support::reexec_in_private_netns;
 use ros2_client::{MessageTypeName, Name, QosProfile};
-use static_node_support::{start_node, static_scenario, Peer};
+use static_node_support::{
+    diagnostic_count, diagnostic_value, publish_until_counted, start_node, static_scenario, Peer,
+};
 
 const DOMAIN_ID: u16 = 24;
 
@@ -66,47 +66,23 @@ fn the_node_counts_the_relposned_of_a_remapped_topic() {
         .node
         .create_publisher::<UbxNavRelPosNed>(&topic, None)
         .unwrap();
-    let value = |d: &DiagnosticArray, key: &str| {
-        d.status[0]
-            .values
-            .iter()
-            .find(|kv| kv.key == key)
-            .map(|kv| kv.value.clone())
-    };
-    let count = |d: &DiagnosticArray, key: &str| {
-        value(d, key)
-            .and_then(|v| v.parse::<u64>().ok())
-            .unwrap_or(0)
-    };
-    // Repeated until counted: our side having matched does not mean the node's reader
-    // has matched our writer yet.
-    let deadline = Instant::now() + Duration::from_secs(20);
-    let mut last: Option<DiagnosticArray> = None;
+    let count = |d: &_, key| diagnostic_count(d, key).unwrap_or(0);
     let mut t_s = 1.0;
-    loop {
-        if let Some(d) = &last {
-            if count(d, "unconvertible_rel_pos_ned") > 0
+    let d = publish_until_counted(
+        &mut peer,
+        || {
+            let mut no_carrier = rel_pos_ned(t_s, CarrierSolution::Fixed);
+            no_carrier.carr_soln.status = CarrSoln::NO_CARRIER_RANGE_SOLUTION;
+            pair.publish(no_carrier).unwrap();
+            pair.publish(rel_pos_ned(t_s + 0.5, CarrierSolution::Float))
+                .unwrap();
+            t_s += 1.0;
+        },
+        |d| {
+            count(d, "unconvertible_rel_pos_ned") > 0
                 && count(d, "rejected_baseline_heading_float") > 0
-            {
-                break;
-            }
-        }
-        assert!(
-            Instant::now() < deadline,
-            "the node never counted the UBXNavRelPosNED: {last:?}"
-        );
-        let mut no_carrier = rel_pos_ned(t_s, CarrierSolution::Fixed);
-        no_carrier.carr_soln.status = CarrSoln::NO_CARRIER_RANGE_SOLUTION;
-        pair.publish(no_carrier).unwrap();
-        pair.publish(rel_pos_ned(t_s + 0.5, CarrierSolution::Float))
-            .unwrap();
-        t_s += 1.0;
-        std::thread::sleep(Duration::from_millis(250));
-        while let Ok(Some((d, _))) = peer.diagnostics.take() {
-            last = Some(d);
-        }
-    }
-    let d = last.unwrap();
+        },
+    );
     let received = count(&d, "rel_pos_ned_received");
     let unconvertible = count(&d, "unconvertible_rel_pos_ned");
     let float = count(&d, "rejected_baseline_heading_float");
@@ -115,6 +91,6 @@ fn the_node_counts_the_relposned_of_a_remapped_topic() {
          {float}"
     );
     assert_eq!(received, unconvertible + float, "{d:?}");
-    let since = value(&d, "rel_pos_ned_since_last_s").unwrap();
+    let since = diagnostic_value(&d, "rel_pos_ned_since_last_s").unwrap();
     assert_ne!(since, "never", "{d:?}");
 }

@@ -175,6 +175,32 @@ pub fn diagnostic_count(d: &DiagnosticArray, key: &str) -> Option<u64> {
     diagnostic_value(d, key).and_then(|v| v.parse().ok())
 }
 
+/// Calls `publish_round` every 250 ms until the newest /diagnostics `peer` heard passes
+/// `done`, and returns that report; panics after 20 s (our side having matched does not
+/// mean the node's reader has matched our writer yet, so a round is repeated).
+pub fn publish_until_counted(
+    peer: &mut Peer,
+    mut publish_round: impl FnMut(),
+    done: impl Fn(&DiagnosticArray) -> bool,
+) -> DiagnosticArray {
+    let deadline = Instant::now() + Duration::from_secs(20);
+    let mut last: Option<DiagnosticArray> = None;
+    loop {
+        if let Some(d) = last.take_if(|d| done(d)) {
+            return d;
+        }
+        assert!(
+            Instant::now() < deadline,
+            "the node never counted what was published: {last:?}"
+        );
+        publish_round();
+        std::thread::sleep(Duration::from_millis(250));
+        while let Ok(Some((d, _))) = peer.diagnostics.take() {
+            last = Some(d);
+        }
+    }
+}
+
 /// What the node published in the last few seconds: every Odometry and transform, and
 /// the newest /diagnostics.
 pub struct Outputs {
