@@ -15,7 +15,6 @@ use adaptive_gnss_ins::ros::convert::seconds_to_time;
 use adaptive_gnss_ins::ros::msg::{CarrSoln, UbxNavRelPosNed};
 use adaptive_gnss_ins::ros::rel_pos_ned::message_of_reading;
 use netns_support::reexec_in_private_netns;
-use ros2_client::{MessageTypeName, Name, QosProfile};
 use static_node_support::{
     diagnostic_count, diagnostic_value, publish_until_counted, start_node, static_scenario, Peer,
 };
@@ -53,19 +52,7 @@ fn the_node_counts_the_relposned_of_a_remapped_topic() {
         ],
     );
     let mut peer = Peer::matched(DOMAIN_ID, "ublox_dgnss", "/test/imu", false);
-    let reliable = QosProfile::publisher_default();
-    let topic = peer
-        .node
-        .create_topic(
-            &Name::parse("/test/pair/ubx_nav_rel_pos_ned").unwrap(),
-            MessageTypeName::new("ublox_ubx_msgs", "UBXNavRelPosNED"),
-            &reliable,
-        )
-        .unwrap();
-    let pair = peer
-        .node
-        .create_publisher::<UbxNavRelPosNed>(&topic, None)
-        .unwrap();
+    let pair = peer.publisher::<UbxNavRelPosNed>("/test/pair/ubx_nav_rel_pos_ned");
     let count = |d: &_, key| diagnostic_count(d, key).unwrap_or(0);
     let mut t_s = 1.0;
     let d = publish_until_counted(

@@ -13,7 +13,6 @@ mod static_node_support;
 use adaptive_gnss_ins::ros::convert::seconds_to_time;
 use adaptive_gnss_ins::ros::msg::Odometry;
 use netns_support::reexec_in_private_netns;
-use ros2_client::{MessageTypeName, Name, QosProfile};
 use static_node_support::{
     diagnostic_count, diagnostic_value, publish_until_counted, start_node, static_scenario, Peer,
 };
@@ -50,19 +49,7 @@ fn the_node_counts_the_wheel_odometry_of_a_remapped_topic() {
         ],
     );
     let mut peer = Peer::matched(DOMAIN_ID, "base_controller", "/test/imu", false);
-    let reliable = QosProfile::publisher_default();
-    let topic = peer
-        .node
-        .create_topic(
-            &Name::parse("/test/base/odom").unwrap(),
-            MessageTypeName::new("nav_msgs", "Odometry"),
-            &reliable,
-        )
-        .unwrap();
-    let wheels = peer
-        .node
-        .create_publisher::<Odometry>(&topic, None)
-        .unwrap();
+    let wheels = peer.publisher::<Odometry>("/test/base/odom");
     let count = |d: &_, key| diagnostic_count(d, key).unwrap_or(0);
     let mut t_s = 1.0;
     let d = publish_until_counted(

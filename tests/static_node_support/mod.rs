@@ -126,6 +126,19 @@ impl Peer {
         peer
     }
 
+    /// A reliable publisher of `M` on `topic` (another input of the node).
+    pub fn publisher<M: RosMessage + serde::Serialize>(&mut self, topic: &str) -> Publisher<M> {
+        let topic = self
+            .node
+            .create_topic(
+                &Name::parse(topic).unwrap(),
+                type_name::<M>(),
+                &QosProfile::publisher_default(),
+            )
+            .unwrap();
+        self.node.create_publisher::<M>(&topic, None).unwrap()
+    }
+
     /// Our side having matched does not mean the node's readers have matched our writers
     /// yet (best effort drops what it sends before): sends an IMU sample with a NaN
     /// (dropped as unconvertible) and an empty GNSS epoch (rejected for having no
