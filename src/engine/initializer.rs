@@ -12,10 +12,10 @@
 //!    solution (tightly coupled) or the receiver's fix (loosely coupled).
 //! 4. The heading is `init.heading_deg` (a compass heading) when given; otherwise a
 //!    dual-antenna pair's heading no older than [`ANTENNA_HEADING_AGE_S`] (with its σ: the
-//!    heading at rest); otherwise the direction of the GNSS velocity once the platform moves, assuming the body's forward
-//!    axis points along the motion (vehicles, walking with the device ahead). Moving: the
-//!    horizontal speed exceeds `init.heading_min_speed_mps` and is significant against its
-//!    own covariance. Loosely coupled without a receiver velocity, the velocity is the
+//!    heading at rest); otherwise the direction of the GNSS velocity once the platform
+//!    moves, assuming the body's forward axis points along the motion (vehicles, walking
+//!    with the device ahead). Moving: the horizontal speed exceeds
+//!    `init.heading_min_speed_mps` and is significant against its own covariance. Loosely coupled without a receiver velocity, the velocity is the
 //!    displacement of the fixes over up to [`super::fix_track::MAX_BASELINE_S`], and the platform moves
 //!    only once that displacement has been significant against the fixes' covariances for
 //!    [`MOTION_EPOCHS`] consecutive fixes: fix noise at a standstill gives no heading.

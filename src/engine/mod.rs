@@ -678,8 +678,8 @@ impl Engine {
                             self.counters
                                 .reject(RejectionReason::BaselineHeadingGated, t);
                         }
-                        // A wheel speed is no GNSS input to monitor, and gives no report
-                        // (as the motion constraints).
+                        // A wheel speed or a baseline heading is no GNSS input to
+                        // monitor, and gives no report (as the motion constraints).
                         if report && gnss {
                             let reset = self.monitor_divergence(&before, &p.measurement, &epoch);
                             out.push(Output::Epoch(epoch));
