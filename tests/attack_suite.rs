@@ -236,6 +236,7 @@ fn header_of(message: &mut InputMessage) -> &mut adaptive_gnss_ins::ros::msg::He
         InputMessage::Fix(m) => &mut m.header,
         InputMessage::Velocity(m) => &mut m.header,
         InputMessage::WheelOdometry(m) => &mut m.header,
+        InputMessage::RelPosNed(m) => &mut m.header,
     }
 }
 

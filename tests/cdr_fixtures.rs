@@ -468,6 +468,45 @@ fn ublox_driver_messages_match_rosbags() {
     check("ubx_rxm_sfrbx", &ubx_rxm_sfrbx(), false);
 }
 
+fn ubx_nav_rel_pos_ned() -> UbxNavRelPosNed {
+    UbxNavRelPosNed {
+        header: header(1_756_402_257, 200_000_000, "rover"),
+        version: 1,
+        ref_station_id: 4095,
+        itow: 408_657_200,
+        rel_pos_n: -87,
+        rel_pos_e: 49,
+        rel_pos_d: -3,
+        rel_pos_length: 100,
+        rel_pos_heading: 15_063_719,
+        rel_pos_hp_n: -42,
+        rel_pos_hp_e: 17,
+        rel_pos_hp_d: -99,
+        rel_pos_hp_length: 5,
+        acc_n: 123,
+        acc_e: 456,
+        acc_d: 789,
+        acc_length: 101,
+        acc_heading: 2_500_000,
+        gnss_fix_ok: true,
+        diff_soln: false,
+        rel_pos_valid: true,
+        carr_soln: CarrSoln {
+            status: CarrSoln::PHASE_WITH_FIXED_AMBIGUITIES,
+        },
+        is_moving: true,
+        ref_pos_miss: false,
+        ref_obs_miss: true,
+        rel_pos_heading_valid: true,
+        rel_pos_normalized: false,
+    }
+}
+
+#[test]
+fn ubx_nav_rel_pos_ned_matches_rosbags_little_and_big_endian() {
+    check("ubx_nav_rel_pos_ned", &ubx_nav_rel_pos_ned(), true);
+}
+
 #[test]
 fn uint8_multi_array_matches_rosbags() {
     check("uint8_multi_array", &uint8_multi_array(), false);
@@ -532,6 +571,10 @@ fn type_names_follow_ros_2_conventions() {
     assert!(SATELLITE_MEASUREMENT_MSG.contains("uint8 GPS=1"));
     assert!(SATELLITE_NOISE_MSG.contains("uint8 REJECTION_MAHALANOBIS=6"));
     assert_eq!(UbxRxmRawx::TYPE_NAME, "ublox_ubx_msgs/msg/UBXRxmRawx");
+    assert_eq!(
+        UbxNavRelPosNed::DDS_TYPE_NAME,
+        "ublox_ubx_msgs::msg::dds_::UBXNavRelPosNED_"
+    );
     assert_eq!(
         UbxRxmSfrbx::DDS_TYPE_NAME,
         "ublox_ubx_msgs::msg::dds_::UBXRxmSfrbx_"

@@ -88,6 +88,14 @@ const EVERY_KEY_CHANGED: &str = "
       enabled: true
       sigma_mps: 0.04
       scale_factor: 1.02
+    dual_antenna:
+      enabled: true
+      baseline_m: [0.1, -1.2, 0.05]
+      length_tolerance_m: 0.03
+      max_sigma_deg: 2.0
+      accept_float: true
+      float_sigma_scale: 4.0
+      gate_sigma: 6.0
     clock:
       bias_noise_m_per_sqrt_s: 0.7
       drift_noise_mps_per_sqrt_s: 0.03

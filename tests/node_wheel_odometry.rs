@@ -10,13 +10,12 @@
 mod netns_support;
 mod static_node_support;
 
-use std::time::{Duration, Instant};
-
 use adaptive_gnss_ins::ros::convert::seconds_to_time;
-use adaptive_gnss_ins::ros::msg::{DiagnosticArray, Odometry};
+use adaptive_gnss_ins::ros::msg::Odometry;
 use netns_support::reexec_in_private_netns;
-use ros2_client::{MessageTypeName, Name, QosProfile};
-use static_node_support::{start_node, static_scenario, Peer};
+use static_node_support::{
+    diagnostic_count, diagnostic_value, publish_until_counted, start_node, static_scenario, Peer,
+};
 
 const DOMAIN_ID: u16 = 23;
 
@@ -50,57 +49,21 @@ fn the_node_counts_the_wheel_odometry_of_a_remapped_topic() {
         ],
     );
     let mut peer = Peer::matched(DOMAIN_ID, "base_controller", "/test/imu", false);
-    let reliable = QosProfile::publisher_default();
-    let topic = peer
-        .node
-        .create_topic(
-            &Name::parse("/test/base/odom").unwrap(),
-            MessageTypeName::new("nav_msgs", "Odometry"),
-            &reliable,
-        )
-        .unwrap();
-    let wheels = peer
-        .node
-        .create_publisher::<Odometry>(&topic, None)
-        .unwrap();
-    let value = |d: &DiagnosticArray, key: &str| {
-        d.status[0]
-            .values
-            .iter()
-            .find(|kv| kv.key == key)
-            .map(|kv| kv.value.clone())
-    };
-    let count = |d: &DiagnosticArray, key: &str| {
-        value(d, key)
-            .and_then(|v| v.parse::<u64>().ok())
-            .unwrap_or(0)
-    };
-    // Repeated until counted: our side having matched does not mean the node's reader
-    // has matched our writer yet.
-    let deadline = Instant::now() + Duration::from_secs(20);
-    let mut last: Option<DiagnosticArray> = None;
+    let wheels = peer.publisher::<Odometry>("/test/base/odom");
+    let count = |d: &_, key| diagnostic_count(d, key).unwrap_or(0);
     let mut t_s = 1.0;
-    loop {
-        if let Some(d) = &last {
-            if count(d, "unconvertible_wheel_odometry") > 0
+    let d = publish_until_counted(
+        &mut peer,
+        || {
+            wheels.publish(odometry(t_s, 1.5)).unwrap();
+            wheels.publish(odometry(t_s + 0.5, f64::NAN)).unwrap();
+            t_s += 1.0;
+        },
+        |d| {
+            count(d, "unconvertible_wheel_odometry") > 0
                 && count(d, "rejected_wheel_speed_before_start") > 0
-            {
-                break;
-            }
-        }
-        assert!(
-            Instant::now() < deadline,
-            "the node never counted the wheel odometry: {last:?}"
-        );
-        wheels.publish(odometry(t_s, 1.5)).unwrap();
-        wheels.publish(odometry(t_s + 0.5, f64::NAN)).unwrap();
-        t_s += 1.0;
-        std::thread::sleep(Duration::from_millis(250));
-        while let Ok(Some((d, _))) = peer.diagnostics.take() {
-            last = Some(d);
-        }
-    }
-    let d = last.unwrap();
+        },
+    );
     let received = count(&d, "wheel_odometry_received");
     let unconvertible = count(&d, "unconvertible_wheel_odometry");
     let before_start = count(&d, "rejected_wheel_speed_before_start");
@@ -109,6 +72,6 @@ fn the_node_counts_the_wheel_odometry_of_a_remapped_topic() {
          start {before_start}"
     );
     assert_eq!(received, unconvertible + before_start, "{d:?}");
-    let since = value(&d, "wheel_odometry_since_last_s").unwrap();
+    let since = diagnostic_value(&d, "wheel_odometry_since_last_s").unwrap();
     assert_ne!(since, "never", "{d:?}");
 }

@@ -75,6 +75,11 @@ fn hash_events(events: &[SimEvent]) -> u64 {
                 f(fix.t_s);
                 fix.position.to_vector().iter().for_each(|&x| f(x));
             }
+            SimEvent::BaselineHeading(h) => {
+                f(h.t_s);
+                f(h.heading_rad);
+                f(h.sigma_rad);
+            }
         }
     }
     h.finish()
@@ -867,4 +872,51 @@ fn carrier_phases_follow_the_range_with_their_own_noise() {
     println!("{pairs} epoch pairs, {starts} track starts, worst |λΔφ − Δρ − Δε| {worst_m} m");
     assert!(pairs > 800 && starts >= 8, "{pairs} pairs, {starts} starts");
     assert!(worst_m < 0.01, "{worst_m} m");
+}
+
+/// A scenario's dual-antenna pair (`dual_antenna`): one heading per fix, the true
+/// baseline's plus an error of the spec's σ; a baseline with no horizontal part or a σ
+/// that is not positive is refused.
+#[test]
+fn a_dual_antenna_pair_reports_its_baselines_heading_with_its_sigma() {
+    use adaptive_gnss_ins::sim::DualAntennaSpec;
+    const SIGMA_DEG: f64 = 0.5;
+    // The static scenario faces north; the rover's antenna 1 m to the right: east.
+    let mut spec = ScenarioSpec::builtin("static").unwrap();
+    spec.dual_antenna = Some(DualAntennaSpec {
+        baseline_m: [0.0, -1.0, 0.0],
+        heading_sigma_deg: SIGMA_DEG,
+    });
+    let scenario = Scenario::new(spec.clone(), 3).unwrap();
+    let (mut fixes, mut errors_deg) = (0, Vec::new());
+    for event in scenario.events() {
+        match event.unwrap() {
+            SimEvent::Fix(_) => fixes += 1,
+            SimEvent::BaselineHeading(h) => {
+                assert_eq!(h.sigma_rad, SIGMA_DEG.to_radians());
+                assert_eq!(h.length_m, 1.0);
+                errors_deg.push(h.heading_rad.to_degrees() - 90.0);
+            }
+            _ => {}
+        }
+    }
+    let n = errors_deg.len() as f64;
+    let mean = errors_deg.iter().sum::<f64>() / n;
+    let sd = (errors_deg.iter().map(|e| (e - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+    println!("{n} headings: error mean {mean:.3} deg, sd {sd:.3} deg (sigma {SIGMA_DEG} deg)");
+    assert_eq!(errors_deg.len(), fixes);
+    assert!(fixes > 100, "{fixes}");
+    // Bounds of about four standard errors.
+    assert!(mean.abs() < 4.0 * SIGMA_DEG / n.sqrt(), "{mean}");
+    assert!(
+        (sd / SIGMA_DEG - 1.0).abs() < 4.0 / (2.0 * n).sqrt(),
+        "{sd}"
+    );
+    for (baseline_m, heading_sigma_deg) in [([0.0, 0.0, 1.0], 0.5), ([1.0, 0.0, 0.0], 0.0)] {
+        spec.dual_antenna = Some(DualAntennaSpec {
+            baseline_m,
+            heading_sigma_deg,
+        });
+        assert!(Scenario::new(spec.clone(), 3).is_err());
+    }
 }

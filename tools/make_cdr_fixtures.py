@@ -84,6 +84,43 @@ uint8 version       # Message version (0x02 for this version)
 
 uint32[] dwrd       # Data words (numWords entries)
 """,
+    # The moving-base pair's relative position (UBX-NAV-RELPOSNED), field for field as in
+    # the driver's UBXNavRelPosNED.msg and CarrSoln.msg (comments ours).
+    "CarrSoln": """
+uint8 CARRIER_SOLUTION_NO_CARRIER_RANGE_SOLUTION = 0
+uint8 CARRIER_SOLUTION_PHASE_WITH_FLOATING_AMBIGUITIES = 1
+uint8 CARRIER_SOLUTION_PHASE_WITH_FIXED_AMBIGUITIES = 2
+uint8 status
+""",
+    "UBXNavRelPosNED": """
+std_msgs/Header header
+uint8 version
+uint16 ref_station_id
+uint32 itow               # ms
+int32 rel_pos_n           # cm
+int32 rel_pos_e           # cm
+int32 rel_pos_d           # cm
+int32 rel_pos_length      # cm
+int32 rel_pos_heading     # 1e-5 deg
+int8 rel_pos_hp_n         # 0.1 mm
+int8 rel_pos_hp_e         # 0.1 mm
+int8 rel_pos_hp_d         # 0.1 mm
+int8 rel_pos_hp_length    # 0.1 mm
+uint32 acc_n              # 0.1 mm
+uint32 acc_e              # 0.1 mm
+uint32 acc_d              # 0.1 mm
+uint32 acc_length         # 0.1 mm
+uint32 acc_heading        # 1e-5 deg
+bool gnss_fix_ok
+bool diff_soln
+bool rel_pos_valid
+CarrSoln carr_soln
+bool is_moving
+bool ref_pos_miss
+bool ref_obs_miss
+bool rel_pos_heading_valid
+bool rel_pos_normalized
+""",
 }
 
 
@@ -361,6 +398,36 @@ def build_messages(ts):
         dwrd=np.array([0x8B00_0001, 0xFFFF_FFFF, 0x0000_2A00], dtype=np.uint32),
     )
 
+    ubx_nav_rel_pos_ned = T[U + "UBXNavRelPosNED"](
+        header=Header(stamp=Time(sec=1_756_402_257, nanosec=200_000_000), frame_id="rover"),
+        version=1,
+        ref_station_id=4095,
+        itow=408_657_200,
+        rel_pos_n=-87,
+        rel_pos_e=49,
+        rel_pos_d=-3,
+        rel_pos_length=100,
+        rel_pos_heading=15_063_719,
+        rel_pos_hp_n=-42,
+        rel_pos_hp_e=17,
+        rel_pos_hp_d=-99,
+        rel_pos_hp_length=5,
+        acc_n=123,
+        acc_e=456,
+        acc_d=789,
+        acc_length=101,
+        acc_heading=2_500_000,
+        gnss_fix_ok=True,
+        diff_soln=False,
+        rel_pos_valid=True,
+        carr_soln=T[U + "CarrSoln"](status=2),
+        is_moving=True,
+        ref_pos_miss=False,
+        ref_obs_miss=True,
+        rel_pos_heading_valid=True,
+        rel_pos_normalized=False,
+    )
+
     MultiArrayDimension = T["std_msgs/msg/MultiArrayDimension"]
     uint8_multi_array = T["std_msgs/msg/UInt8MultiArray"](
         layout=T["std_msgs/msg/MultiArrayLayout"](
@@ -382,12 +449,13 @@ def build_messages(ts):
         ("noise_estimates", f"{PACKAGE}/msg/NoiseEstimates", noise_estimates),
         ("ubx_rxm_rawx", U + "UBXRxmRawx", ubx_rxm_rawx),
         ("ubx_rxm_sfrbx", U + "UBXRxmSfrbx", ubx_rxm_sfrbx),
+        ("ubx_nav_rel_pos_ned", U + "UBXNavRelPosNED", ubx_nav_rel_pos_ned),
         ("uint8_multi_array", "std_msgs/msg/UInt8MultiArray", uint8_multi_array),
     ]
 
 
 # Fixtures also written big-endian (CDR_BE), to prove the decoder reads that encapsulation.
-BIG_ENDIAN_TOO = {"imu", "gnss_measurements", "ubx_rxm_rawx"}
+BIG_ENDIAN_TOO = {"imu", "gnss_measurements", "ubx_rxm_rawx", "ubx_nav_rel_pos_ned"}
 
 
 def main():

@@ -40,9 +40,9 @@ pub use convert::{
 pub use error::ConfigError;
 pub use param_file::{NodeParameters, MAX_FILE_BYTES};
 pub use parameters::{
-    AdaptiveConfig, ClockConfig, Config, ConstraintsConfig, EngineConfig, FilterConfig, GnssConfig,
-    ImuConfig, InitConfig, LooseConfig, MountingConfig, OutputConfig, RobustConfig,
-    WheelOdometryConfig,
+    AdaptiveConfig, ClockConfig, Config, ConstraintsConfig, DualAntennaConfig, EngineConfig,
+    FilterConfig, GnssConfig, ImuConfig, InitConfig, LooseConfig, MountingConfig, OutputConfig,
+    RobustConfig, WheelOdometryConfig,
 };
 pub use sections::{AdaptiveFactorKind, Coupling, EquivalentWeightKind, Platform};
 pub use spec::{Interval, Kind, Range};

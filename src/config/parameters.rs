@@ -227,6 +227,46 @@ parameter_table! {
             unit "", range Range::Within(Interval::closed(0.5, 2.0)), at_start;
     }
 
+    /// Dual-antenna heading (optional): a moving-base u-blox pair's relative position
+    /// (ublox_ubx_msgs/UBXNavRelPosNED on ubx_nav_rel_pos_ned, as ublox_dgnss publishes it)
+    /// measures the heading of the baseline from the moving base's antenna to the rover's.
+    /// It gives the heading at rest: a start parked takes it, and the running filter is
+    /// updated with each valid message (relPosValid, relPosHeadingValid, moving base and a
+    /// carrier solution), its sigma the message's accHeading.
+    section dual_antenna: DualAntennaConfig {
+        /// Use the baseline headings (the node subscribes ubx_nav_rel_pos_ned only then);
+        /// when off, headings given to the engine are rejected and counted.
+        enabled: bool = false, unit "", range ANY, at_start;
+        /// The baseline from the moving base's antenna to the rover's antenna in the body
+        /// frame [forward, left, up]: [1, 0, 0] = the rover's antenna 1 m ahead of the
+        /// base's, [0, -1, 0] = 1 m to its right (heading offset +90 deg).
+        // Choice: a vector rather than a heading offset: it gives the offset, the
+        // baseline's length (checked against the message's, a wrong ambiguity fix shows
+        // there) and, for antennas at different heights, the exact heading of a tilted
+        // baseline. Beyond 100 m it is a unit mistake.
+        baseline_b_m: Vector3<f64> ["baseline_m": [f64; 3]] = [1.0, 0.0, 0.0],
+            unit "m", range Range::Within(Interval::closed(-100.0, 100.0)), at_start,
+            si ToVector;
+        /// Largest |measured length - configured length| of the baseline; a message beyond
+        /// it is rejected and counted (a wrong integer fix or a wrong baseline_m).
+        length_tolerance_m: f64 = 0.1, unit "m", range SIGMA, at_start;
+        /// Largest accHeading accepted (after the float scale); beyond, the message is
+        /// rejected and counted.
+        max_sigma_rad: f64 ["max_sigma_deg": f64] = 5.0,
+            unit "deg", range Range::Within(Interval::above(0.0, 180.0)), at_start,
+            si Scale::to("rad", RAD_PER_DEG);
+        /// Accept a float carrier solution (ambiguities not fixed), its sigma multiplied by
+        /// float_sigma_scale; when off, float solutions are rejected and counted.
+        accept_float: bool = false, unit "", range ANY, at_start;
+        /// Factor on a float solution's accHeading (accept_float): the receiver's accuracy
+        /// of an unfixed baseline is optimistic.
+        float_sigma_scale: f64 = 3.0, unit "", range FACTOR_MAX, at_start;
+        /// Innovation gate of the running filter's heading update, in sigmas of the
+        /// innovation (the heading's variance and the filter's); a heading beyond it is
+        /// rejected and counted, never applied.
+        gate_sigma: f64 = 5.0, unit "", range THRESHOLD, at_start;
+    }
+
     /// Receiver clock model: bias c*dt_u (m) and drift c*dt_ru (m/s). The defaults are a
     /// typical TCXO (Allan coefficients h0 = 2e-19, h-2 = 2e-20, Brown & Hwang):
     /// sqrt(h0/2)*c = 0.1 m/sqrt(s), sqrt(2 pi^2 h-2)*c = 0.2 (m/s)/sqrt(s).

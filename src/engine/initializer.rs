@@ -10,11 +10,12 @@
 //! 2. Until the filter starts, the levelled attitude is carried forward by the gyros alone.
 //! 3. Position, velocity and clock come from an iterated least-squares single-point
 //!    solution (tightly coupled) or the receiver's fix (loosely coupled).
-//! 4. The heading is `init.heading_deg` (a compass heading) when given; otherwise the
-//!    direction of the GNSS velocity once the platform moves, assuming the body's forward
-//!    axis points along the motion (vehicles, walking with the device ahead). Moving: the
-//!    horizontal speed exceeds `init.heading_min_speed_mps` and is significant against its
-//!    own covariance. Loosely coupled without a receiver velocity, the velocity is the
+//! 4. The heading is `init.heading_deg` (a compass heading) when given; otherwise a
+//!    dual-antenna pair's heading no older than [`ANTENNA_HEADING_AGE_S`] (with its σ: the
+//!    heading at rest); otherwise the direction of the GNSS velocity once the platform
+//!    moves, assuming the body's forward axis points along the motion (vehicles, walking
+//!    with the device ahead). Moving: the horizontal speed exceeds
+//!    `init.heading_min_speed_mps` and is significant against its own covariance. Loosely coupled without a receiver velocity, the velocity is the
 //!    displacement of the fixes over up to [`super::fix_track::MAX_BASELINE_S`], and the platform moves
 //!    only once that displacement has been significant against the fixes' covariances for
 //!    [`MOTION_EPOCHS`] consecutive fixes: fix noise at a standstill gives no heading.
@@ -58,6 +59,9 @@ const MOTION_EPOCHS: usize = 3;
 /// 1-sigma of the body's forward axis against the course (rad): side-slip and the
 /// mounting's yaw. Choice: 3°, a car's side-slip in a brisk turn.
 const COURSE_SIGMA_RAD: f64 = 3.0 * std::f64::consts::PI / 180.0;
+/// Oldest dual-antenna heading a start takes (s). Choice: 1 s, a few of the pair's epochs;
+/// the body turns little in that time while levelled or parked.
+const ANTENNA_HEADING_AGE_S: f64 = 1.0;
 /// A GNSS speed above this denies the levelling's rest (m/s). Choice: 0.5 m/s, above the
 /// speed noise of a single-point velocity and below a walking pace.
 const REST_SPEED_MAX_MPS: f64 = 0.5;
@@ -180,6 +184,27 @@ pub struct Initializer {
     /// IMU class's `imu.gyro_bias_deg_per_h` (1, or [`DIVERGED_GYRO_BIAS_SIGMA_FACTOR`]
     /// after a divergence).
     gyro_bias_sigma_factor: f64,
+    /// The newest dual-antenna heading of the body.
+    antenna_heading: Option<AntennaHeading>,
+}
+
+/// A dual-antenna pair's heading of the body's x axis.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AntennaHeading {
+    pub t_s: f64,
+    /// Compass heading (clockwise from north, rad).
+    pub heading_rad: f64,
+    pub sigma_rad: f64,
+}
+
+/// The heading a start takes.
+#[derive(Debug, Clone, Copy)]
+struct StartHeading {
+    /// ENU yaw (rad).
+    yaw_rad: f64,
+    from_motion: bool,
+    /// Its 1-sigma when it comes with one (a dual antenna), rad.
+    sigma_rad: Option<f64>,
 }
 
 impl Default for Initializer {
@@ -193,6 +218,7 @@ impl Default for Initializer {
             moving_fixes: 0,
             velocity: None,
             gyro_bias_sigma_factor: 1.0,
+            antenna_heading: None,
         }
     }
 }
@@ -254,6 +280,11 @@ impl Initializer {
             (Some(_), false) => InitPhase::WaitingForPosition,
             (Some(_), true) => InitPhase::WaitingForHeading,
         }
+    }
+
+    /// Keeps a dual-antenna heading for the start.
+    pub fn note_antenna_heading(&mut self, heading: AntennaHeading) {
+        self.antenna_heading = Some(heading);
     }
 
     /// Feeds one body-frame IMU sample.
@@ -336,10 +367,13 @@ impl Initializer {
         let (alignment, from_motion) = match self.attitude.clone() {
             Some(attitude) => {
                 self.position_known = true;
-                let (yaw, from_motion) = self.heading(v_enu.as_ref(), config)?;
-                let q_nb = replace_yaw(&attitude.q_nb, yaw);
-                let course = self.velocity.filter(|_| from_motion);
-                (Self::levelled(q_nb, course, config), from_motion)
+                let heading = self.heading(epoch.t_s, v_enu.as_ref(), config)?;
+                let q_nb = replace_yaw(&attitude.q_nb, heading.yaw_rad);
+                let course = self.velocity.filter(|_| heading.from_motion);
+                (
+                    Self::levelled(q_nb, course, heading.sigma_rad, config),
+                    heading.from_motion,
+                )
             }
             None => (self.align_in_motion(previous, recent, config)?, true),
         };
@@ -402,11 +436,12 @@ impl Initializer {
             Some(attitude) => {
                 self.position_known = true;
                 let v = velocity.filter(|v| fix.velocity_enu_mps.is_some() || v.moving(config));
-                let (yaw, from_motion) = self.heading(v.map(|v| v.v_enu_mps).as_ref(), config)?;
-                let q_nb = replace_yaw(&attitude.q_nb, yaw);
+                let heading = self.heading(fix.t_s, v.map(|v| v.v_enu_mps).as_ref(), config)?;
+                let q_nb = replace_yaw(&attitude.q_nb, heading.yaw_rad);
+                let course = v.filter(|_| heading.from_motion);
                 (
-                    Self::levelled(q_nb, v.filter(|_| from_motion), config),
-                    from_motion,
+                    Self::levelled(q_nb, course, heading.sigma_rad, config),
+                    heading.from_motion,
                 )
             }
             None => (self.align_in_motion(previous, recent, config)?, true),
@@ -458,16 +493,20 @@ impl Initializer {
 
     /// The levelled attitude turned to the heading found, with the configured 1-sigmas; a
     /// heading from the `course` of a GNSS velocity has at least the course's own
-    /// uncertainty and [`COURSE_SIGMA_RAD`].
+    /// uncertainty and [`COURSE_SIGMA_RAD`]; one with its own σ (`heading_sigma_rad`, a
+    /// dual antenna) has that.
     fn levelled(
         q_nb: UnitQuaternion<f64>,
         course: Option<GnssVelocity>,
+        heading_sigma_rad: Option<f64>,
         config: &Config,
     ) -> Alignment {
         let i = &config.init;
-        let heading_sigma = course.map_or(i.heading_sigma_rad, |v| {
-            i.heading_sigma_rad
-                .max(v.course_sigma_rad().hypot(COURSE_SIGMA_RAD))
+        let heading_sigma = heading_sigma_rad.unwrap_or_else(|| {
+            course.map_or(i.heading_sigma_rad, |v| {
+                i.heading_sigma_rad
+                    .max(v.course_sigma_rad().hypot(COURSE_SIGMA_RAD))
+            })
         });
         Alignment {
             q_nb,
@@ -532,13 +571,36 @@ impl Initializer {
         })
     }
 
-    /// Heading (ENU yaw, rad) and whether it came from motion; None while unknown.
-    fn heading(&self, v_enu: Option<&Vector3<f64>>, config: &Config) -> Option<(f64, bool)> {
+    /// The heading of a start at `t_s` (see the module documentation); None while unknown.
+    fn heading(
+        &self,
+        t_s: f64,
+        v_enu: Option<&Vector3<f64>>,
+        config: &Config,
+    ) -> Option<StartHeading> {
         if let Some(heading) = config.init.heading_rad {
-            return Some((enu_yaw_of_heading(heading), false));
+            return Some(StartHeading {
+                yaw_rad: enu_yaw_of_heading(heading),
+                from_motion: false,
+                sigma_rad: None,
+            });
+        }
+        if let Some(a) = self
+            .antenna_heading
+            .filter(|a| (t_s - a.t_s).abs() <= ANTENNA_HEADING_AGE_S)
+        {
+            return Some(StartHeading {
+                yaw_rad: enu_yaw_of_heading(a.heading_rad),
+                from_motion: false,
+                sigma_rad: Some(a.sigma_rad),
+            });
         }
         let v = v_enu?;
-        (v[0].hypot(v[1]) >= config.init.heading_min_speed_mps).then(|| (v[1].atan2(v[0]), true))
+        (v[0].hypot(v[1]) >= config.init.heading_min_speed_mps).then(|| StartHeading {
+            yaw_rad: v[1].atan2(v[0]),
+            from_motion: true,
+            sigma_rad: None,
+        })
     }
 
     fn initial_state(

@@ -23,6 +23,9 @@
 //! - Wheel speeds (`wheel_odometry.*`, [`wheel_odometry`]) take the measurements' path
 //!   (waiting, roll-back, duplicates by kind) while the filter runs; before, start-up has
 //!   no use for them and they are rejected and counted.
+//! - Dual-antenna headings (`dual_antenna.*`, [`dual_antenna`]) take the same path; before
+//!   the start the initializer keeps the newest as the start's heading (a start at rest),
+//!   while running each is a measurement, gated against the filter's heading.
 //! - Start-up (`initializer`): levelled at rest, or aligned in motion from GNSS when
 //!   the IMU's window is not at rest (a start or a restart mid-drive); a start whose
 //!   heading is too uncertain for one filter runs a bank of heading hypotheses first
@@ -38,6 +41,7 @@ mod adaptation;
 pub mod adaptive_noise;
 mod constraints;
 pub mod divergence;
+mod dual_antenna;
 mod filter_state;
 mod fix_track;
 pub mod heading_bank;
@@ -70,6 +74,7 @@ use wheel_odometry::WheelSpeedReading;
 
 pub use adaptation::Adaptation;
 pub use constraints::ConstraintUpdates;
+pub use dual_antenna::{BaselineHeadingReading, CarrierSolution};
 pub use filter_state::{interpolate, FilterState};
 pub use initializer::{InitPhase, Initializer};
 pub use output::{
@@ -114,6 +119,7 @@ enum Measurement {
     Gnss(GnssEpoch),
     Fix(GnssFix),
     WheelSpeed(WheelSpeedReading),
+    BaselineHeading(BaselineHeadingReading),
 }
 
 impl Measurement {
@@ -122,6 +128,7 @@ impl Measurement {
             Self::Gnss(e) => e.t_s,
             Self::Fix(f) => f.t_s,
             Self::WheelSpeed(w) => w.t_s,
+            Self::BaselineHeading(h) => h.t_s,
         }
     }
 
@@ -439,6 +446,19 @@ impl Engine {
         self.push_measurement(Measurement::WheelSpeed(reading))
     }
 
+    /// Feeds one heading of a dual-antenna pair's baseline, when `dual_antenna.enabled`
+    /// and it passes the screening of [`BaselineHeadingReading`]; before the start it
+    /// becomes the start's heading.
+    pub fn push_baseline_heading(
+        &mut self,
+        reading: BaselineHeadingReading,
+    ) -> Result<Vec<Output>, InputRejected> {
+        if let Err(reason) = reading.screen(&self.config) {
+            return Err(self.counters.reject(reason, reading.t_s));
+        }
+        self.push_measurement(Measurement::BaselineHeading(reading))
+    }
+
     fn push_measurement(&mut self, m: Measurement) -> Result<Vec<Output>, InputRejected> {
         let t = m.t_s();
         let Some(last_t) = self.last_imu_t_s() else {
@@ -644,12 +664,26 @@ impl Engine {
                         let mut model = reading.model(&self.config);
                         update::apply(state, &mut model, adaptation, false)
                     }
+                    // Choice: nor from a baseline heading, for the same reasons.
+                    Measurement::BaselineHeading(reading) => {
+                        let mut model = reading.model(&self.config);
+                        update::apply(state, &mut model, adaptation, false)
+                    }
                 };
-                let gnss = !matches!(p.measurement, Measurement::WheelSpeed(_));
+                let gnss = matches!(p.measurement, Measurement::Gnss(_) | Measurement::Fix(_));
                 match result {
                     Ok(epoch) if state.is_finite() => {
-                        // A wheel speed is no GNSS input to monitor, and gives no report
-                        // (as the motion constraints).
+                        // The baseline heading's model leaves out a heading beyond its
+                        // gate: no rows, counted once.
+                        if report
+                            && epoch.measurements_used == 0
+                            && matches!(p.measurement, Measurement::BaselineHeading(_))
+                        {
+                            self.counters
+                                .reject(RejectionReason::BaselineHeadingGated, t);
+                        }
+                        // A wheel speed or a baseline heading is no GNSS input to
+                        // monitor, and gives no report (as the motion constraints).
                         if report && gnss {
                             let reset = self.monitor_divergence(&before, &p.measurement, &epoch);
                             out.push(Output::Epoch(epoch));

@@ -194,6 +194,8 @@ pub enum MeasurementKind {
     NonHolonomic,
     /// The forward speed of a wheeled vehicle from its wheels (wheel odometry).
     WheelSpeed,
+    /// The heading of a dual-antenna (moving-base) receiver pair's baseline.
+    BaselineHeading,
     /// Time-differenced carrier phases: each satellite's phase change since the previous
     /// epoch (tightly coupled; its satellites' pseudo-range fields report the phase change,
     /// in m, and its rate fields are unused).

@@ -39,7 +39,7 @@ impl Engine {
                 velocity: f.velocity_enu_mps.zip(f.velocity_covariance_enu_m2_s2),
             }),
             Measurement::Gnss(e) => single_point_if_gated(e, report, prior, &self.config),
-            Measurement::WheelSpeed(_) => None,
+            Measurement::WheelSpeed(_) | Measurement::BaselineHeading(_) => None,
         };
         let disagreement = gnss.map(|g| {
             Disagreement::of(

@@ -46,6 +46,20 @@ pub enum RejectionReason {
     WheelOdometryOff,
     /// A wheel speed before the filter runs (start-up uses GNSS only).
     WheelSpeedBeforeStart,
+    /// A baseline heading whose time, heading, σ or length is not finite, or whose σ or
+    /// length is not positive.
+    BaselineHeadingInvalid,
+    /// A baseline heading while `dual_antenna.enabled` is off.
+    DualAntennaOff,
+    /// A baseline heading of a float carrier solution (`dual_antenna.accept_float` off).
+    BaselineHeadingFloat,
+    /// A baseline heading whose σ exceeds `dual_antenna.max_sigma_deg`.
+    BaselineHeadingInaccurate,
+    /// A baseline whose length differs from `dual_antenna.baseline_m`'s by more than
+    /// `dual_antenna.length_tolerance_m`.
+    BaselineLengthMismatch,
+    /// A baseline heading beyond `dual_antenna.gate_sigma` of the running filter's.
+    BaselineHeadingGated,
 }
 
 impl RejectionReason {
@@ -71,6 +85,12 @@ impl RejectionReason {
             Self::WheelSpeedInvalid => "wheel_speed_invalid",
             Self::WheelOdometryOff => "wheel_odometry_off",
             Self::WheelSpeedBeforeStart => "wheel_speed_before_start",
+            Self::BaselineHeadingInvalid => "baseline_heading_invalid",
+            Self::DualAntennaOff => "dual_antenna_off",
+            Self::BaselineHeadingFloat => "baseline_heading_float",
+            Self::BaselineHeadingInaccurate => "baseline_heading_inaccurate",
+            Self::BaselineLengthMismatch => "baseline_length_mismatch",
+            Self::BaselineHeadingGated => "baseline_heading_gated",
         }
     }
 }

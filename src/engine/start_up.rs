@@ -28,6 +28,10 @@ impl Engine {
             Measurement::Gnss(e) => init.try_gnss(e, &self.config, &recent),
             Measurement::Fix(f) => init.try_fix(f, &self.config, &recent),
             Measurement::WheelSpeed(_) => None,
+            Measurement::BaselineHeading(reading) => {
+                init.note_antenna_heading(reading.start_heading(&self.config));
+                None
+            }
         };
         let Some(initial) = started else {
             return;
@@ -116,6 +120,10 @@ impl Engine {
                     update::apply(state, &mut model, adaptation, true)
                 }
                 Measurement::WheelSpeed(reading) => {
+                    let mut model = reading.model(config);
+                    update::apply(state, &mut model, adaptation, false)
+                }
+                Measurement::BaselineHeading(reading) => {
                     let mut model = reading.model(config);
                     update::apply(state, &mut model, adaptation, false)
                 }

@@ -277,7 +277,7 @@ fn advance_position(
 }
 
 /// Wraps an angle to (−π, π].
-fn wrap_pi(a: f64) -> f64 {
+pub fn wrap_pi(a: f64) -> f64 {
     use std::f64::consts::PI;
     let w = (a + PI).rem_euclid(2.0 * PI) - PI;
     if w <= -PI {

@@ -106,6 +106,15 @@ pub enum ConvertError {
         /// What is allowed.
         expected: &'static str,
     },
+    /// A UBXNavRelPosNED that gives no baseline heading (see
+    /// [`crate::ros::rel_pos_ned`]).
+    #[error("UBXNavRelPosNED at {t_s} s: {reason}")]
+    NoBaselineHeading {
+        /// Stamp of the message (s).
+        t_s: f64,
+        /// Which flag says so.
+        reason: &'static str,
+    },
     /// A NavSatFix whose status says the receiver has no solution.
     #[error("NavSatFix at {t_s} s: status {status}, no solution")]
     NoFix {

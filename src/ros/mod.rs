@@ -7,6 +7,8 @@
 //!   header + CDR body).
 //! - [`convert`]: wire messages -> core types (`GnssEpoch`, `ImuSample`) and ROS time.
 //! - [`fix_velocity`], [`fix_pairing`]: `gnss/fix` joined with its `gnss/velocity`.
+//! - [`rel_pos_ned`]: a moving-base u-blox pair's UBXNavRelPosNED -> the engine's
+//!   baseline heading.
 //! - [`outbound`]: engine outputs -> Odometry, NavSatFix, NoiseEstimates, TF.
 //! - [`adapter`]: the engine behind decoded messages in and messages to publish out, with
 //!   the node's conversion, frame locks, time-jump rule, non-finite guard and counters;
@@ -37,5 +39,6 @@ pub mod node;
 pub mod outbound;
 pub mod param_overrides;
 pub mod player;
+pub mod rel_pos_ned;
 pub mod ubx_adapter;
 pub mod ubx_node;

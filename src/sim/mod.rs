@@ -22,5 +22,5 @@ pub use imu_errors::{ImuErrorModel, ImuErrorModelError, ImuErrorSpec};
 pub use scenario::{GnssTruth, Scenario, ScenarioEvents, SimEvent};
 pub use scenario_clock::ScenarioClock;
 pub use scenario_error::ScenarioError;
-pub use scenario_spec::ScenarioSpec;
+pub use scenario_spec::{DualAntennaSpec, ScenarioSpec};
 pub use trajectory::{Segment, Trajectory, TrajectoryError, TrajectorySpec, TruthSample};

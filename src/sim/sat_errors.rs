@@ -46,6 +46,8 @@ pub enum StreamPurpose {
     CarrierPhase = 8,
     /// The integer ambiguity of a satellite's carrier-phase track.
     CarrierAmbiguity = 9,
+    /// A dual-antenna pair's heading error.
+    BaselineHeading = 10,
 }
 
 /// 32-bit words reserved per epoch (or segment) in a stream. Choice: 2²⁰ words; an epoch

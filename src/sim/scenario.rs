@@ -8,16 +8,17 @@
 //! The epochs are taken at true GPS time (the receiver clock bias appears in the
 //! pseudo-ranges, not in the time tags).
 //!
-//! Order of events at equal times: Imu, Truth, Environment, Gnss, Fix — so a consumer has
-//! the IMU up to an epoch before the epoch itself.
+//! Order of events at equal times: Imu, Truth, Environment, Gnss, Fix, BaselineHeading —
+//! so a consumer has the IMU up to an epoch before the epoch itself.
 
 use std::collections::VecDeque;
 
 use nalgebra::{Matrix3, Vector3};
 use rand_chacha::rand_core::Rng;
+use rand_distr::{Distribution, StandardNormal};
 
 use crate::earth::{earth_rate_enu_rad_s, ecef_to_llh, llh_to_ecef, rot_ecef_to_enu};
-use crate::engine::GnssFix;
+use crate::engine::{BaselineHeadingReading, CarrierSolution, GnssFix};
 use crate::gnss::geometry::{elevation_azimuth, line_of_sight};
 use crate::gnss::spp::{solve_spp, SigmaModel, SppConfig, SppSolution};
 use crate::gnss::{GnssEpoch, SatId};
@@ -95,6 +96,9 @@ pub enum SimEvent {
     /// A receiver-like fix of the antenna: the single-point solution of the same epoch
     /// (none when it fails or its PDOP exceeds 10).
     Fix(GnssFix),
+    /// The heading of the dual-antenna pair's baseline (with `dual_antenna` in the spec),
+    /// a fixed carrier solution, at the epochs with a fix.
+    BaselineHeading(BaselineHeadingReading),
 }
 
 impl SimEvent {
@@ -106,6 +110,7 @@ impl SimEvent {
             SimEvent::Environment { t_s, .. } => *t_s,
             SimEvent::Gnss { epoch, .. } => epoch.t_s,
             SimEvent::Fix(f) => f.t_s,
+            SimEvent::BaselineHeading(h) => h.t_s,
         }
     }
 }
@@ -366,8 +371,35 @@ impl Scenario {
         });
         if let Some(fix) = fix {
             out.push_back(SimEvent::Fix(fix));
+            if let Some(heading) = self.baseline_heading(index, t_s, &c_bn) {
+                out.push_back(SimEvent::BaselineHeading(heading));
+            }
         }
         Ok(())
+    }
+
+    /// The dual-antenna pair's heading at epoch `index` of a body whose attitude is
+    /// `c_bn`: the true baseline's heading plus an error of the spec's σ (its own stream).
+    fn baseline_heading(
+        &self,
+        index: u64,
+        t_s: f64,
+        c_bn: &Matrix3<f64>,
+    ) -> Option<BaselineHeadingReading> {
+        let d = self.spec.dual_antenna.as_ref()?;
+        let baseline_b = Vector3::from(d.baseline_m);
+        let u = c_bn * baseline_b;
+        let sigma_rad = d.heading_sigma_deg.to_radians();
+        let mut rng = stream_rng(self.seed, StreamPurpose::BaselineHeading, None, index);
+        let error: f64 = StandardNormal.sample(&mut rng);
+        Some(BaselineHeadingReading {
+            t_s,
+            heading_rad: (u[0].atan2(u[1]) + sigma_rad * error)
+                .rem_euclid(2.0 * std::f64::consts::PI),
+            sigma_rad,
+            length_m: baseline_b.norm(),
+            carrier: CarrierSolution::Fixed,
+        })
     }
 }
 

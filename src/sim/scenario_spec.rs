@@ -235,6 +235,21 @@ impl Default for GnssSpec {
     }
 }
 
+/// A dual-antenna (moving-base) receiver pair on the vehicle: at each GNSS epoch with a
+/// fix, the heading of its baseline with a Gaussian error.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DualAntennaSpec {
+    /// The baseline from the moving base's antenna to the rover's, body FLU (m); its
+    /// horizontal part at least 0.1 m.
+    pub baseline_m: [f64; 3],
+    /// 1-sigma of the heading's error (deg), positive; also the reported accuracy.
+    pub heading_sigma_deg: f64,
+}
+
+/// Shortest horizontal baseline of a dual-antenna pair (m).
+const MIN_BASELINE_M: f64 = 0.1;
+
 /// A whole scenario.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -255,6 +270,9 @@ pub struct ScenarioSpec {
     /// Environment segments (non-overlapping); open sky elsewhere.
     #[serde(default)]
     pub environments: Vec<EnvironmentSegment>,
+    /// A dual-antenna pair (none by default).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dual_antenna: Option<DualAntennaSpec>,
 }
 
 impl ScenarioSpec {
@@ -378,6 +396,25 @@ impl ScenarioSpec {
                 field: format!("gnss.receiver_clock.{field}"),
                 reason: "must be finite (h-coefficients non-negative)",
             });
+        }
+        if let Some(d) = &self.dual_antenna {
+            let [x, y, z] = d.baseline_m;
+            if !([x, y, z]
+                .iter()
+                .all(|v| v.is_finite() && v.abs() <= MAX_LEVER_ARM_M)
+                && x.hypot(y) >= MIN_BASELINE_M)
+            {
+                return Err(invalid(
+                    "dual_antenna.baseline_m",
+                    "components must be finite and within ±100 m, the horizontal part ≥ 0.1 m",
+                ));
+            }
+            if !(d.heading_sigma_deg.is_finite() && d.heading_sigma_deg > 0.0) {
+                return Err(invalid(
+                    "dual_antenna.heading_sigma_deg",
+                    "must be finite and positive",
+                ));
+            }
         }
         self.validate_environments()
     }

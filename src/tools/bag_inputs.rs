@@ -14,7 +14,7 @@ use crate::ros::cdr;
 use crate::ros::convert::time_to_seconds;
 use crate::ros::msg::{
     DiagnosticArray, GnssMeasurements, Imu, NavSatFix, NoiseEstimates, Odometry, RosMessage,
-    TFMessage, TwistWithCovarianceStamped,
+    TFMessage, TwistWithCovarianceStamped, UbxNavRelPosNed,
 };
 
 use super::scoring::Reference;
@@ -39,6 +39,9 @@ pub struct BagTopics {
     /// when the run publishes `map → odom` (`tf_mode` `map_to_odom`, as the node then
     /// subscribes `/tf`); None: not read.
     pub tf: Option<String>,
+    /// ublox_ubx_msgs/UBXNavRelPosNED of a moving-base pair, whose baseline heading is fed
+    /// with `dual_antenna.enabled`.
+    pub rel_pos_ned: String,
     /// nav_msgs/Odometry reference in an ENU frame at `truth_datum` (None: no reference).
     pub truth: Option<String>,
     pub truth_datum: String,
@@ -56,6 +59,7 @@ impl Default for BagTopics {
             velocity: VELOCITY_TOPIC.to_owned(),
             wheel_odometry: WHEEL_ODOMETRY_TOPIC.to_owned(),
             tf: None,
+            rel_pos_ned: REL_POS_NED_TOPIC.to_owned(),
             truth: Some(TRUTH_TOPIC.to_owned()),
             truth_datum: TRUTH_DATUM_TOPIC.to_owned(),
             truth_noise: TRUTH_NOISE_TOPIC.to_owned(),
@@ -85,6 +89,7 @@ impl Role {
             Role::Input(Input::Velocity) => TwistWithCovarianceStamped::TYPE_NAME,
             Role::Input(Input::WheelOdometry) | Role::Truth => Odometry::TYPE_NAME,
             Role::Tf => TFMessage::TYPE_NAME,
+            Role::Input(Input::RelPosNed) => UbxNavRelPosNed::TYPE_NAME,
             Role::TruthNoise => NoiseEstimates::TYPE_NAME,
             Role::Environment => DiagnosticArray::TYPE_NAME,
         }
@@ -106,6 +111,8 @@ impl BagTopics {
             Some(Role::Input(Input::WheelOdometry))
         } else if self.tf.as_deref() == Some(topic) {
             Some(Role::Tf)
+        } else if topic == self.rel_pos_ned {
+            Some(Role::Input(Input::RelPosNed))
         } else if topic == self.truth_datum {
             Some(Role::TruthDatum)
         } else if self.truth.as_deref() == Some(topic) {
@@ -269,6 +276,7 @@ impl BagInputs {
                 InputMessage::WheelOdometry(Box::new(decode(data)?))
             }
             Role::Tf => return Ok(Some(BagInput::Tf(decode(data)?))),
+            Role::Input(Input::RelPosNed) => InputMessage::RelPosNed(Box::new(decode(data)?)),
             Role::TruthDatum => {
                 let msg: NavSatFix = decode(data)?;
                 self.datum = Some(Llh::from_degrees(msg.latitude, msg.longitude, msg.altitude));

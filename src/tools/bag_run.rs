@@ -16,12 +16,14 @@ use super::bag_inputs::{BagInput, BagInputs, BagTopics, ReadProblems};
 use super::scoring::{Scorer, SessionReport};
 
 /// The input streams a run of `config` feeds: the IMU, the measurements of the
-/// configured coupling and, with `wheel_odometry.enabled`, the wheel odometry.
+/// configured coupling and, with `wheel_odometry.enabled` and `dual_antenna.enabled`, the
+/// wheel odometry and the dual-antenna pair's relative position.
 ///
 /// Choice: the node receives the other coupling's measurements too, and its engine
 /// rejects each as `wrong_coupling` without any other effect; a bag carries both (the
 /// simulator writes both), so a run counts them once as unfed instead of logging a
-/// rejection for each. The same for a wheel odometry the configuration does not use.
+/// rejection for each. The same for a wheel odometry or dual-antenna heading the
+/// configuration does not use.
 fn fed_inputs(config: &Config) -> Vec<Input> {
     let mut fed = match config.filter.coupling {
         Coupling::Tight => vec![Input::Imu, Input::Gnss],
@@ -29,6 +31,9 @@ fn fed_inputs(config: &Config) -> Vec<Input> {
     };
     if config.wheel_odometry.enabled {
         fed.push(Input::WheelOdometry);
+    }
+    if config.dual_antenna.enabled {
+        fed.push(Input::RelPosNed);
     }
     fed
 }

@@ -42,6 +42,7 @@ pub fn scenario_inputs(
                 Ok(SessionInput::Gnss(epoch)),
             ],
             Ok(SimEvent::Fix(f)) => vec![Ok(SessionInput::Fix(f))],
+            Ok(SimEvent::BaselineHeading(h)) => vec![Ok(SessionInput::BaselineHeading(h))],
         };
         inputs.into_iter()
     })

@@ -3,7 +3,7 @@
 //! [`super::bag_run`]); the tests drive simulated scenarios through this.
 
 use crate::config::{Config, Coupling};
-use crate::engine::{Engine, GnssFix, Output};
+use crate::engine::{BaselineHeadingReading, Engine, GnssFix, Output};
 use crate::eval::TruthTrack;
 use crate::gnss::GnssEpoch;
 use crate::ins::ImuSample;
@@ -22,6 +22,8 @@ pub enum SessionInput {
         speed_mps: f64,
         sigma_mps: Option<f64>,
     },
+    /// A dual-antenna pair's baseline heading.
+    BaselineHeading(BaselineHeadingReading),
     Reference(Reference),
 }
 
@@ -59,6 +61,7 @@ impl Session {
                 speed_mps,
                 sigma_mps,
             } => self.engine.push_wheel_speed(t_s, speed_mps, sigma_mps),
+            SessionInput::BaselineHeading(h) => self.engine.push_baseline_heading(h),
             SessionInput::Reference(r) => {
                 self.scorer.on_reference(r);
                 return Vec::new();

@@ -14,6 +14,9 @@
 //!   geometry_msgs/TwistWithCovarianceStamped, the receiver's velocity of each fix that has
 //!   one (ENU, in the fix's frame as GNSS drivers send it), stamped like its fix and written
 //!   just after it;
+//! - only for a scenario with a `dual_antenna`: `/ubx_nav_rel_pos_ned`
+//!   ublox_ubx_msgs/UBXNavRelPosNED, the moving-base pair's heading at each fix (frame
+//!   `gnss_moving_base`), written just after its fix;
 //! - `/ground_truth` nav_msgs/Odometry of the true IMU position in the ENU frame `map`
 //!   whose origin is the trajectory's start, written in `/ground_truth/datum`
 //!   (sensor_msgs/NavSatFix, once at the start);
@@ -33,9 +36,10 @@ use crate::ins::error_state::StateMatrix;
 use crate::ros::bag::{BagError, BagWriter};
 use crate::ros::msg::{
     DiagnosticArray, DiagnosticStatus, GnssMeasurements, Header, Imu, NavSatFix, NavSatStatus,
-    NoiseEstimates, Odometry, SatelliteNoise, TwistWithCovarianceStamped,
+    NoiseEstimates, Odometry, SatelliteNoise, TwistWithCovarianceStamped, UbxNavRelPosNed,
 };
 use crate::ros::outbound;
+use crate::ros::rel_pos_ned::message_of_reading;
 use crate::sim::constellation::GpsConstellation;
 use crate::sim::scenario::{Scenario, SimEvent};
 use crate::sim::{ScenarioClock, ScenarioError};
@@ -47,6 +51,8 @@ pub const IMU_TOPIC: &str = "/imu";
 pub const GNSS_TOPIC: &str = "/gnss/measurements";
 pub const FIX_TOPIC: &str = "/gnss/fix";
 pub const VELOCITY_TOPIC: &str = "/gnss/velocity";
+/// ublox_dgnss's `ubx_nav_rel_pos_ned` in the root namespace.
+pub const REL_POS_NED_TOPIC: &str = "/ubx_nav_rel_pos_ned";
 pub const TRUTH_TOPIC: &str = "/ground_truth";
 pub const TRUTH_DATUM_TOPIC: &str = "/ground_truth/datum";
 pub const TRUTH_NOISE_TOPIC: &str = "/ground_truth/noise";
@@ -71,6 +77,8 @@ pub struct SimulateSummary {
     pub fixes: usize,
     /// Messages on `/gnss/velocity` (0 unless asked for).
     pub velocities: usize,
+    /// Messages on `/ubx_nav_rel_pos_ned` (0 unless the scenario has a dual antenna).
+    pub rel_pos_ned: usize,
     pub truth: usize,
 }
 
@@ -139,6 +147,9 @@ pub fn simulate_with_progress(
     if options.velocity {
         bag.add_topic::<TwistWithCovarianceStamped>(VELOCITY_TOPIC)?;
     }
+    if scenario.spec().dual_antenna.is_some() {
+        bag.add_topic::<UbxNavRelPosNed>(REL_POS_NED_TOPIC)?;
+    }
     bag.add_topic::<Odometry>(TRUTH_TOPIC)?;
     bag.add_topic::<NavSatFix>(TRUTH_DATUM_TOPIC)?;
     bag.add_topic::<NoiseEstimates>(TRUTH_NOISE_TOPIC)?;
@@ -203,6 +214,11 @@ pub fn simulate_with_progress(
                     bag.write(VELOCITY_TOPIC, &v, ns)?;
                     summary.velocities += 1;
                 }
+            }
+            SimEvent::BaselineHeading(heading) => {
+                let msg = message_of_reading(&heading, st, "gnss_moving_base");
+                bag.write(REL_POS_NED_TOPIC, &msg, ns)?;
+                summary.rel_pos_ned += 1;
             }
         }
     }

@@ -126,6 +126,19 @@ impl Peer {
         peer
     }
 
+    /// A reliable publisher of `M` on `topic` (another input of the node).
+    pub fn publisher<M: RosMessage + serde::Serialize>(&mut self, topic: &str) -> Publisher<M> {
+        let topic = self
+            .node
+            .create_topic(
+                &Name::parse(topic).unwrap(),
+                type_name::<M>(),
+                &QosProfile::publisher_default(),
+            )
+            .unwrap();
+        self.node.create_publisher::<M>(&topic, None).unwrap()
+    }
+
     /// Our side having matched does not mean the node's readers have matched our writers
     /// yet (best effort drops what it sends before): sends an IMU sample with a NaN
     /// (dropped as unconvertible) and an empty GNSS epoch (rejected for having no
@@ -173,6 +186,32 @@ pub fn diagnostic_value(d: &DiagnosticArray, key: &str) -> Option<String> {
 /// The counter `key` of the node's /diagnostics report `d`.
 pub fn diagnostic_count(d: &DiagnosticArray, key: &str) -> Option<u64> {
     diagnostic_value(d, key).and_then(|v| v.parse().ok())
+}
+
+/// Calls `publish_round` every 250 ms until the newest /diagnostics `peer` heard passes
+/// `done`, and returns that report; panics after 20 s (our side having matched does not
+/// mean the node's reader has matched our writer yet, so a round is repeated).
+pub fn publish_until_counted(
+    peer: &mut Peer,
+    mut publish_round: impl FnMut(),
+    done: impl Fn(&DiagnosticArray) -> bool,
+) -> DiagnosticArray {
+    let deadline = Instant::now() + Duration::from_secs(20);
+    let mut last: Option<DiagnosticArray> = None;
+    loop {
+        if let Some(d) = last.take_if(|d| done(d)) {
+            return d;
+        }
+        assert!(
+            Instant::now() < deadline,
+            "the node never counted what was published: {last:?}"
+        );
+        publish_round();
+        std::thread::sleep(Duration::from_millis(250));
+        while let Ok(Some((d, _))) = peer.diagnostics.take() {
+            last = Some(d);
+        }
+    }
 }
 
 /// What the node published in the last few seconds: every Odometry and transform, and

@@ -20,9 +20,10 @@
 //! previous epoch; [`apply_gnss_epoch`] runs both), [`FixMeasurement`] (loosely coupled: a
 //! receiver's position and velocity fix), and the constraints of the vehicle's motion
 //! (`super::constraints`): [`ZeroVelocity`], [`ZeroRate`] at a standstill and
-//! [`NonHolonomic`] for a wheeled vehicle; [`WheelSpeed`] (wheel odometry, optional).
+//! [`NonHolonomic`] for a wheeled vehicle; [`WheelSpeed`] (wheel odometry, optional);
+//! [`BaselineHeading`] (a dual-antenna receiver pair's heading, optional).
 //!
-//! Adding a model (a dual-antenna heading, ...): a file here with a type that
+//! Adding a model: a file here with a type that
 //! borrows the measurement and the configuration and implements [`MeasurementModel`]; its `linearize` returns the rows of H
 //! (new rows belong in [`crate::filter::measurement_rows`]), the measured and predicted
 //! values and the nominal noise — [`NominalNoise::Joint`] for a vector measurement (the
@@ -33,6 +34,7 @@
 //! `update::apply(state, &mut model, adaptation, learn)`. `tests.rs` runs the
 //! zero-velocity model through every base and scheme.
 
+mod baseline_heading;
 mod carrier_phase_deltas;
 mod fix;
 mod gate;
@@ -65,6 +67,7 @@ use super::output::EpochReport;
 use super::phase_anchor::PhaseAnchor;
 use gate::{gate, GateRow};
 
+pub use baseline_heading::BaselineHeading;
 pub use carrier_phase_deltas::CarrierPhaseDeltas;
 pub(crate) use fix::{position_covariance, velocity_covariance};
 pub use fix::{FixMeasurement, GnssFix};

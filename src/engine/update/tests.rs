@@ -7,14 +7,15 @@ use nalgebra::{DVector, UnitQuaternion, Vector3};
 use crate::config::{Config, FilterVariant};
 use crate::earth::Llh;
 use crate::filter::robust_update::UpdateOutcome;
-use crate::ins::error_state::{StateMatrix, StateVector, DV, N};
+use crate::ins::error_state::{StateMatrix, StateVector, DV, N, PHI};
 use crate::ins::{ImuSample, NavState};
 
 use super::super::adaptation::Adaptation;
 use super::super::filter_state::FilterState;
 use super::super::output::{EpochReport, MeasurementKind};
 use super::{
-    apply, Linearization, MeasurementModel, NonHolonomic, WheelSpeed, ZeroRate, ZeroVelocity,
+    apply, BaselineHeading, Linearization, MeasurementModel, NonHolonomic, WheelSpeed, ZeroRate,
+    ZeroVelocity,
 };
 
 /// The zero-velocity model, reporting the robust weights in the fix's field.
@@ -164,6 +165,54 @@ fn constraint_rows_match_differences() {
         speed_mps: 12.0,
         sigma_mps: 0.05,
     });
+}
+
+/// The baseline heading's row against differences, for a baseline ahead, to the right
+/// and tilted, with the measured heading on either side of north (the wrap).
+#[test]
+fn baseline_heading_rows_match_differences() {
+    for baseline in [
+        Vector3::new(1.0, 0.0, 0.0),
+        Vector3::new(0.0, -1.5, 0.0),
+        Vector3::new(0.8, 0.6, 0.4),
+    ] {
+        for heading_rad in [0.01, 6.27, 2.0] {
+            check_rows(BaselineHeading {
+                t_s: 0.0,
+                baseline_b_m: &baseline,
+                heading_rad,
+                sigma_rad: 0.01,
+                // Choice: no gate here: the rows are checked whatever the innovation.
+                gate_sigma: f64::INFINITY,
+            });
+        }
+    }
+}
+
+/// A heading beyond the gate gives no rows (the engine counts it); within, one row whose
+/// prediction is wrapped to within π of the measurement.
+#[test]
+fn baseline_heading_gates_and_wraps() {
+    let baseline = Vector3::new(1.0, 0.0, 0.0);
+    let mut state = moving_state(1e-4);
+    // ENU yaw π/2 − 0.05: the body x axis points 0.05 rad east of north.
+    state.nav.q_nb =
+        UnitQuaternion::from_euler_angles(0.0, 0.0, std::f64::consts::FRAC_PI_2 - 0.05);
+    let model = |heading_rad: f64| BaselineHeading {
+        t_s: 0.0,
+        baseline_b_m: &baseline,
+        heading_rad,
+        sigma_rad: 0.02,
+        gate_sigma: 5.0,
+    };
+    let mut report = EpochReport::new(0.0, MeasurementKind::BaselineHeading, "ekf");
+    let near = model(2.0 * std::f64::consts::PI - 0.01).linearize(&mut state.clone(), &mut report);
+    assert_eq!(near.rows.len(), 1);
+    let innovation = near.predicted[0] - near.measured[0];
+    assert!((innovation - 0.06).abs() < 1e-9, "{innovation}");
+    let heading_sigma = state.p[(PHI + 2, PHI + 2)].sqrt();
+    let far = model(0.05 + 6.0 * heading_sigma.hypot(0.02)).linearize(&mut state, &mut report);
+    assert!(far.rows.is_empty());
 }
 
 /// The zero-rate rows leave out the attitude's part of the earth rate (below 1e-7 rad/s

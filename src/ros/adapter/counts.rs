@@ -13,16 +13,20 @@ pub enum Input {
     Velocity,
     /// `wheel/odometry`: nav_msgs/Odometry of the base controller (its forward speed).
     WheelOdometry,
+    /// `ubx_nav_rel_pos_ned`: ublox_ubx_msgs/UBXNavRelPosNED of a moving-base receiver
+    /// (the dual-antenna heading).
+    RelPosNed,
 }
 
 impl Input {
     /// Every input, in the order of the /diagnostics report.
-    pub const ALL: [Input; 5] = [
+    pub const ALL: [Input; 6] = [
         Input::Imu,
         Input::Gnss,
         Input::Fix,
         Input::Velocity,
         Input::WheelOdometry,
+        Input::RelPosNed,
     ];
 
     /// The node's topic name of the stream (relative).
@@ -33,6 +37,7 @@ impl Input {
             Input::Fix => "gnss/fix",
             Input::Velocity => "gnss/velocity",
             Input::WheelOdometry => "wheel/odometry",
+            Input::RelPosNed => "ubx_nav_rel_pos_ned",
         }
     }
 
@@ -45,6 +50,7 @@ impl Input {
             Input::Fix => "fix",
             Input::Velocity => "velocity",
             Input::WheelOdometry => "wheel_odometry",
+            Input::RelPosNed => "rel_pos_ned",
         }
     }
 
@@ -64,7 +70,8 @@ pub struct StreamCounts {
     /// Messages decoded.
     pub received: u64,
     /// Messages that decoded but did not convert (a bad stamp, a non-finite value, no
-    /// solution in a NavSatFix, an unknown constellation...).
+    /// solution in a NavSatFix, an unknown constellation, a UBXNavRelPosNED without a
+    /// carrier-phase heading...).
     pub unconvertible: u64,
     /// Messages from another frame than the locked one (a second publisher); velocities
     /// neither in the map frame nor in their fix's frame (the fix is used without).

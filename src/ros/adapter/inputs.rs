@@ -1,13 +1,14 @@
 //! Decoded input messages into the engine: conversion, frame locks, the IMU time line and
 //! the fix / velocity join; what is dropped is counted and logged (rate-limited).
 
-use crate::engine::{GnssFix, Output, ResetReason};
+use crate::engine::{BaselineHeadingReading, GnssFix, Output, ResetReason};
 use crate::gnss::GnssEpoch;
 use crate::ins::ImuSample;
 use crate::ros::convert::{GnssVelocity, WheelOdometrySpeed};
 use crate::ros::fix_velocity::{FramedFix, Joined, VelocityUse};
 use crate::ros::msg::{
     GnssMeasurements, Imu, NavSatFix, Odometry, TFMessage, Time, TwistWithCovarianceStamped,
+    UbxNavRelPosNed,
 };
 
 use super::frame_lock::Admission;
@@ -22,6 +23,7 @@ pub enum InputMessage {
     Fix(NavSatFix),
     Velocity(TwistWithCovarianceStamped),
     WheelOdometry(Box<Odometry>),
+    RelPosNed(Box<UbxNavRelPosNed>),
 }
 
 impl RosAdapter {
@@ -33,6 +35,7 @@ impl RosAdapter {
             InputMessage::Fix(m) => self.on_fix(m),
             InputMessage::Velocity(m) => self.on_velocity(m),
             InputMessage::WheelOdometry(m) => self.on_wheel_odometry(m),
+            InputMessage::RelPosNed(m) => self.on_rel_pos_ned(m),
         }
     }
 
@@ -228,6 +231,36 @@ impl RosAdapter {
         self.publishable(outputs)
     }
 
+    /// Handles one UBXNavRelPosNED of a moving-base pair on `ubx_nav_rel_pos_ned`: its
+    /// baseline heading ([`crate::ros::rel_pos_ned`]) goes to the engine, which screens
+    /// and counts it (`dual_antenna.*`). The stream is locked to one `header.frame_id`
+    /// (the driver's `frame_id`: one receiver pair).
+    pub fn on_rel_pos_ned(&mut self, msg: &UbxNavRelPosNed) -> Vec<Published> {
+        self.counts.stream_mut(Input::RelPosNed).received += 1;
+        let reading = match BaselineHeadingReading::try_from(msg) {
+            Ok(r) => r,
+            Err(e) => return self.unconvertible(Input::RelPosNed, &e.to_string()),
+        };
+        let frame_id = &msg.header.frame_id;
+        match self.rel_pos_frame.admit(frame_id) {
+            Admission::Admitted => {}
+            Admission::Foreign => return self.foreign_frame(Input::RelPosNed, frame_id),
+            Admission::Switched => self.frame_switched(Input::RelPosNed, frame_id),
+        }
+        let outputs = match self.engine.push_baseline_heading(reading) {
+            Ok(o) => {
+                self.rel_pos_frame.accepted(frame_id);
+                o
+            }
+            Err(e) => {
+                self.log
+                    .warn(e.reason.name(), &format!("dual-antenna heading: {e}"));
+                Vec::new()
+            }
+        };
+        self.publishable(outputs)
+    }
+
     /// Feeds joined fixes; what the engine returned, to publish.
     fn publish_fixes(&mut self, joined: Vec<Joined>) -> Vec<Published> {
         let mut outputs = Vec::new();
@@ -284,6 +317,7 @@ impl RosAdapter {
                 self.outputs.frames().map_frame
             ),
             Input::WheelOdometry => format!("child frame `{}`", self.wheel_frame.locked()),
+            Input::RelPosNed => format!("`{}`", self.rel_pos_frame.locked()),
         };
         self.counts.stream_mut(input).foreign_frame += 1;
         let name = input.name();

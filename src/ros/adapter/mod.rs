@@ -66,6 +66,8 @@ pub struct RosAdapter {
     fix_frame: FrameLock,
     /// The wheel odometry's `child_frame_id`.
     wheel_frame: FrameLock,
+    /// The dual-antenna pair's `header.frame_id`.
+    rel_pos_frame: FrameLock,
     pairing: FixVelocityJoin,
     outputs: outputs::Framing,
     /// The stamps of the IMU samples, which solutions carry.
@@ -90,6 +92,7 @@ impl RosAdapter {
             gnss_frame: FrameLock::default(),
             fix_frame: FrameLock::default(),
             wheel_frame: FrameLock::default(),
+            rel_pos_frame: FrameLock::default(),
             imu_stamps: StampBook::default(),
             measurement_stamps: StampBook::default(),
             phases: PhaseCounts::default(),

@@ -151,12 +151,13 @@ impl Framing {
                     .map(|s| s.sat.constellation),
             ),
             MeasurementKind::Fix => self.fix_service,
-            // The engine reports no epochs of its motion constraints or of the wheel
-            // speed: they use no signal.
+            // The engine reports no epochs of its motion constraints, of the wheel
+            // speed or of the baseline heading: they use no satellite of its own.
             MeasurementKind::ZeroVelocity
             | MeasurementKind::ZeroRate
             | MeasurementKind::NonHolonomic
-            | MeasurementKind::WheelSpeed => return,
+            | MeasurementKind::WheelSpeed
+            | MeasurementKind::BaselineHeading => return,
             // Choice: the phases' report rides inside its epoch's pseudo-range report,
             // which names the service; on its own it changes nothing.
             MeasurementKind::CarrierPhaseDeltas => return,

@@ -913,3 +913,72 @@ fn wheel_odometry_is_counted_on_diagnostics() {
     assert_eq!(counters.count(RejectionReason::WheelSpeedInvalid), 0);
     assert_eq!(counters.count(RejectionReason::WheelOdometryOff), 0);
 }
+
+/// Issue 14, item 4: a moving-base pair's UBXNavRelPosNED on /diagnostics. The static
+/// scenario's receiver stands facing north with no configured heading: with
+/// `dual_antenna.enabled` and a pair reporting north at each fix, the filter starts (it
+/// cannot without: no course at rest). Each message is counted as received; one without a
+/// carrier solution or not in moving-base mode as unconvertible, one from a second pair as
+/// foreign, a float solution as rejected.
+#[test]
+fn a_dual_antenna_heading_starts_a_receiver_at_rest_and_is_counted() {
+    use crate::engine::{BaselineHeadingReading, CarrierSolution};
+    use crate::ros::msg::CarrSoln;
+    use crate::ros::rel_pos_ned::message_of_reading;
+    use crate::sim::SimEvent;
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/params/ekf_loose.yaml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut config = Config::from_yaml_str(&text, path).unwrap();
+    let mut without = RosAdapter::new(config.clone(), OutputFrames::default());
+    config
+        .set_parameter("dual_antenna.enabled", "true")
+        .unwrap();
+    let mut adapter = RosAdapter::new(config, OutputFrames::default());
+    let north = |t_s: f64, carrier| BaselineHeadingReading {
+        t_s,
+        heading_rad: 0.0,
+        sigma_rad: 0.3f64.to_radians(),
+        length_m: 1.0,
+        carrier,
+    };
+    let mut sent = 0;
+    for_each_static_event_30_s(|event, stamp| {
+        if let SimEvent::Imu(s) = &event {
+            adapter.on_imu(&outbound::imu(s, stamp, "imu"));
+            without.on_imu(&outbound::imu(s, stamp, "imu"));
+        }
+        if let SimEvent::Fix(f) = &event {
+            let msg = message_of_reading(&north(f.t_s, CarrierSolution::Fixed), stamp, "pair");
+            adapter.on_rel_pos_ned(&msg);
+            adapter.on_fix(&outbound::receiver_fix(f, stamp, "gnss"));
+            without.on_rel_pos_ned(&msg);
+            without.on_fix(&outbound::receiver_fix(f, stamp, "gnss"));
+            sent += 1;
+        }
+    });
+    let late = seconds_to_time(29.995).unwrap();
+    let mut no_carrier = message_of_reading(&north(29.995, CarrierSolution::Fixed), late, "pair");
+    no_carrier.carr_soln.status = CarrSoln::NO_CARRIER_RANGE_SOLUTION;
+    let mut static_base = no_carrier.clone();
+    static_base.carr_soln.status = CarrSoln::PHASE_WITH_FIXED_AMBIGUITIES;
+    static_base.is_moving = false;
+    let float = message_of_reading(&north(29.995, CarrierSolution::Float), late, "pair");
+    let foreign = message_of_reading(&north(29.995, CarrierSolution::Fixed), late, "other_pair");
+    for msg in [no_carrier, static_base, float, foreign] {
+        adapter.on_message(&InputMessage::RelPosNed(Box::new(msg)));
+    }
+    assert_eq!(adapter.engine().init_phase(), None, "running");
+    assert_eq!(
+        without.engine().init_phase(),
+        Some(crate::engine::InitPhase::WaitingForHeading)
+    );
+    let count = |key: &str| diagnostic(&adapter, key).unwrap().parse::<u64>().unwrap();
+    assert!(sent > 20, "{sent}");
+    assert_eq!(count("rel_pos_ned_received"), sent + 4);
+    assert_eq!(count("unconvertible_rel_pos_ned"), 2);
+    assert_eq!(count("foreign_frame_rel_pos_ned"), 1);
+    assert_eq!(count("rejected_baseline_heading_float"), 1);
+    let counters = adapter.engine().counters();
+    assert_eq!(counters.count(RejectionReason::BaselineHeadingGated), 0);
+    assert_eq!(counters.count(RejectionReason::BaselineHeadingInvalid), 0);
+}

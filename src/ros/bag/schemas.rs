@@ -183,6 +183,45 @@ uint8 version
 uint32[] dwrd
 ";
 
+/// `ublox_ubx_msgs/CarrSoln`.
+pub const CARR_SOLN_MSG: &str = "\
+uint8 CARRIER_SOLUTION_NO_CARRIER_RANGE_SOLUTION = 0
+uint8 CARRIER_SOLUTION_PHASE_WITH_FLOATING_AMBIGUITIES = 1
+uint8 CARRIER_SOLUTION_PHASE_WITH_FIXED_AMBIGUITIES = 2
+uint8 status
+";
+
+/// `ublox_ubx_msgs/UBXNavRelPosNED`.
+pub const UBX_NAV_REL_POS_NED_MSG: &str = "\
+std_msgs/Header header
+uint8 version
+uint16 ref_station_id
+uint32 itow
+int32 rel_pos_n
+int32 rel_pos_e
+int32 rel_pos_d
+int32 rel_pos_length
+int32 rel_pos_heading
+int8 rel_pos_hp_n
+int8 rel_pos_hp_e
+int8 rel_pos_hp_d
+int8 rel_pos_hp_length
+uint32 acc_n
+uint32 acc_e
+uint32 acc_d
+uint32 acc_length
+uint32 acc_heading
+bool gnss_fix_ok
+bool diff_soln
+bool rel_pos_valid
+CarrSoln carr_soln
+bool is_moving
+bool ref_pos_miss
+bool ref_obs_miss
+bool rel_pos_heading_valid
+bool rel_pos_normalized
+";
+
 /// Every known definition text, keyed by `pkg/Type` (no `msg/` in the middle).
 const DEFINITIONS: &[(&str, &str)] = &[
     ("builtin_interfaces/Time", TIME_MSG),
@@ -221,6 +260,8 @@ const DEFINITIONS: &[(&str, &str)] = &[
     ("ublox_ubx_msgs/RawxData", RAWX_DATA_MSG),
     ("ublox_ubx_msgs/UBXRxmRawx", UBX_RXM_RAWX_MSG),
     ("ublox_ubx_msgs/UBXRxmSfrbx", UBX_RXM_SFRBX_MSG),
+    ("ublox_ubx_msgs/CarrSoln", CARR_SOLN_MSG),
+    ("ublox_ubx_msgs/UBXNavRelPosNED", UBX_NAV_REL_POS_NED_MSG),
     (
         "adaptive_gnss_ins/SatelliteMeasurement",
         SATELLITE_MEASUREMENT_MSG,

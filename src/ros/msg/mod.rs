@@ -36,7 +36,7 @@ pub use rcl::{Log, ParameterEvent};
 pub use rosgraph::Clock;
 pub use sensor::{Imu, NavSatFix, NavSatStatus};
 pub use tf2::TFMessage;
-pub use ublox::{RawxData, RecStat, TrkStat, UbxRxmRawx, UbxRxmSfrbx};
+pub use ublox::{CarrSoln, RawxData, RecStat, TrkStat, UbxNavRelPosNed, UbxRxmRawx, UbxRxmSfrbx};
 
 /// A ROS 2 message type and the names it is known by.
 pub trait RosMessage: serde::Serialize + serde::de::DeserializeOwned {

@@ -112,3 +112,76 @@ pub struct UbxRxmSfrbx {
     pub dwrd: Vec<u32>,
 }
 ros_message!(UbxRxmSfrbx, "ublox_ubx_msgs", "UBXRxmSfrbx");
+
+/// `ublox_ubx_msgs/msg/CarrSoln`: the carrier-phase range solution of a NAV-RELPOSNED
+/// message (flags.carrSoln).
+#[derive(Serialize, Deserialize, Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct CarrSoln {
+    /// One of the `CARRIER_SOLUTION_*` values.
+    pub status: u8,
+}
+ros_message!(CarrSoln, "ublox_ubx_msgs", "CarrSoln");
+
+impl CarrSoln {
+    /// No carrier-phase range solution.
+    pub const NO_CARRIER_RANGE_SOLUTION: u8 = 0;
+    /// Carrier phase with floating ambiguities.
+    pub const PHASE_WITH_FLOATING_AMBIGUITIES: u8 = 1;
+    /// Carrier phase with fixed ambiguities.
+    pub const PHASE_WITH_FIXED_AMBIGUITIES: u8 = 2;
+}
+
+/// `ublox_ubx_msgs/msg/UBXNavRelPosNED` (topic `ubx_nav_rel_pos_ned`): the relative
+/// position of the rover's antenna from the reference (UBX-NAV-RELPOSNED), in the payload's
+/// integer units. In moving-base mode the reference is the moving base's antenna, and the
+/// relative position is the baseline between the two antennas.
+#[derive(Serialize, Deserialize, Debug, Clone, PartialEq, Eq, Default)]
+pub struct UbxNavRelPosNed {
+    /// Host receive time and the driver's frame.
+    pub header: Header,
+    /// Message version.
+    pub version: u8,
+    /// Reference station id (0..4095).
+    pub ref_station_id: u16,
+    /// GPS time of week of the navigation epoch (ms).
+    pub itow: u32,
+    /// North, east and down components of the relative position (cm).
+    pub rel_pos_n: i32,
+    pub rel_pos_e: i32,
+    pub rel_pos_d: i32,
+    /// Length of the relative position (cm).
+    pub rel_pos_length: i32,
+    /// Heading of the relative position, clockwise from north (1e-5 deg).
+    pub rel_pos_heading: i32,
+    /// High-precision parts of the components and the length (0.1 mm): the full value is
+    /// the cm field + this × 1e-2 cm.
+    pub rel_pos_hp_n: i8,
+    pub rel_pos_hp_e: i8,
+    pub rel_pos_hp_d: i8,
+    pub rel_pos_hp_length: i8,
+    /// Accuracies of the components and the length (0.1 mm).
+    pub acc_n: u32,
+    pub acc_e: u32,
+    pub acc_d: u32,
+    pub acc_length: u32,
+    /// Accuracy of the heading (1e-5 deg).
+    pub acc_heading: u32,
+    /// A valid fix (within the DOP and accuracy masks).
+    pub gnss_fix_ok: bool,
+    /// Differential corrections were applied.
+    pub diff_soln: bool,
+    /// The components and accuracies are valid (moving base: the baseline too).
+    pub rel_pos_valid: bool,
+    pub carr_soln: CarrSoln,
+    /// The receiver is in moving-base mode.
+    pub is_moving: bool,
+    /// An extrapolated reference position was used this epoch.
+    pub ref_pos_miss: bool,
+    /// Extrapolated reference observations were used this epoch.
+    pub ref_obs_miss: bool,
+    /// `rel_pos_heading` is valid.
+    pub rel_pos_heading_valid: bool,
+    /// The components (high-precision parts included) are normalized.
+    pub rel_pos_normalized: bool,
+}
+ros_message!(UbxNavRelPosNed, "ublox_ubx_msgs", "UBXNavRelPosNED");

@@ -15,6 +15,8 @@ pub enum Stream {
     Velocity,
     /// `wheel/odometry` (subscribed with `wheel_odometry.enabled`).
     WheelOdometry,
+    /// `ubx_nav_rel_pos_ned` (subscribed with `dual_antenna.enabled`).
+    RelPosNed,
 }
 
 impl Stream {
@@ -41,7 +43,14 @@ pub const IMU_STALE_S: f64 = 1.0;
 
 /// `gnss_ins_node`'s streams; the IMU is watched.
 pub const FILTER_NODE_STREAMS: StreamSet = StreamSet {
-    keys: &["imu", "gnss", "fix", "velocity", "wheel_odometry"],
+    keys: &[
+        "imu",
+        "gnss",
+        "fix",
+        "velocity",
+        "wheel_odometry",
+        "rel_pos_ned",
+    ],
     watched: &[(0, IMU_STALE_S)],
 };
 

@@ -4,7 +4,9 @@
 //! Topics (relative, so `__ns` and remappings apply): subscribes `imu`
 //! (sensor_msgs/Imu), `gnss/measurements` (GnssMeasurements), `gnss/fix` (NavSatFix),
 //! `gnss/velocity` (TwistWithCovarianceStamped), with `wheel_odometry.enabled`
-//! `wheel/odometry` (nav_msgs/Odometry of the base controller), `/clock`
+//! `wheel/odometry` (nav_msgs/Odometry of the base controller), with
+//! `dual_antenna.enabled` `ubx_nav_rel_pos_ned` (ublox_ubx_msgs/UBXNavRelPosNED of a
+//! moving-base pair, as ublox_dgnss names it), `/clock`
 //! (rosgraph_msgs/Clock, for `use_sim_time`); publishes `odometry` (nav_msgs/Odometry,
 //! `map_frame` → `base_frame`), `fix/filtered` (NavSatFix), `~/noise_estimates`
 //! (NoiseEstimates), `/diagnostics` (DiagnosticArray, 1 Hz), `/rosout`
@@ -33,7 +35,7 @@ use crate::ros::args::NodeArgs;
 use crate::ros::log_limit::LogLimiter;
 use crate::ros::msg::{
     Clock, DiagnosticArray, GnssMeasurements, Imu, Log, NavSatFix, NoiseEstimates, Odometry,
-    ParameterEvent, TFMessage, Time, TwistWithCovarianceStamped,
+    ParameterEvent, TFMessage, Time, TwistWithCovarianceStamped, UbxNavRelPosNed,
 };
 
 use clock::NodeClock;
@@ -53,6 +55,7 @@ enum Event {
     Fix(Result<NavSatFix, String>),
     Velocity(Result<TwistWithCovarianceStamped, String>),
     WheelOdometry(Result<Box<Odometry>, String>),
+    RelPosNed(Result<Box<UbxNavRelPosNed>, String>),
     Clock(Result<Clock, String>),
     Tf(Result<TFMessage, String>),
     Param(ParamRequest),
@@ -132,6 +135,15 @@ pub fn run(
     } else {
         None
     };
+    let rel_pos_sub = if params.config.dual_antenna.enabled {
+        Some(subscription::<UbxNavRelPosNed>(
+            &mut node,
+            &names,
+            "ubx_nav_rel_pos_ned",
+        )?)
+    } else {
+        None
+    };
     let clock_sub = subscription::<Clock>(&mut node, &names, "/clock")?;
     let tf_sub = if params.frames.published_tf() == TfMode::MapToOdom {
         Some(subscription::<TFMessage>(&mut node, &names, "/tf")?)
@@ -188,6 +200,11 @@ pub fn run(
         wheel_sub
             .as_ref()
             .map(|sub| events(sub, |m| Event::WheelOdometry(m.map(Box::new)))),
+    );
+    sources.extend(
+        rel_pos_sub
+            .as_ref()
+            .map(|sub| events(sub, |m| Event::RelPosNed(m.map(Box::new)))),
     );
     sources.extend(tf_sub.as_ref().map(|sub| events(sub, Event::Tf)));
     sources.extend(housekeeping::housekeeping(
@@ -249,6 +266,13 @@ pub fn run(
                     match m {
                         Ok(m) => core.on_wheel_odometry(&m),
                         Err(e) => undecodable(&mut core, "wheel/odometry", &e),
+                    }
+                }
+                Event::RelPosNed(m) => {
+                    stats.record(Stream::RelPosNed.index(), now_s());
+                    match m {
+                        Ok(m) => core.on_rel_pos_ned(&m),
+                        Err(e) => undecodable(&mut core, "ubx_nav_rel_pos_ned", &e),
                     }
                 }
                 Event::Clock(Ok(m)) => {
