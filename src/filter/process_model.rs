@@ -11,7 +11,8 @@ use nalgebra::{Matrix3, Vector3};
 
 use crate::earth::{self, Llh};
 use crate::ins::error_state::{
-    StateMatrix, StateVector, ACC_BIAS, CLOCK_BIAS, CLOCK_DRIFT, DP, DV, GYRO_BIAS, GYRO_GM, N, PHI,
+    StateMatrix, StateVector, ACC_BIAS, ACC_SCALE, CLOCK_BIAS, CLOCK_DRIFT, DP, DV, GYRO_BIAS,
+    GYRO_GM, GYRO_SCALE, N, PHI, WHEEL_SCALE,
 };
 use crate::ins::NavState;
 
@@ -36,6 +37,22 @@ pub struct ProcessNoise {
     pub clock_drift_noise_m_s_per_sqrt_s: f64,
     /// Correlation time T_ru of the clock drift (s).
     pub clock_drift_time_s: f64,
+    /// White noise driving the wheel odometry scale factor (a random walk, 1/√s); zero
+    /// when the state is off.
+    pub wheel_scale_noise_per_sqrt_s: f64,
+    /// The IMU scale-factor states (`imu.scale_factor_states`); None: inert.
+    pub imu_scale: Option<ImuScaleNoise>,
+}
+
+/// First-order Gauss-Markov models of the IMU scale-factor errors (as KF-GINS carries them).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImuScaleNoise {
+    /// Steady-state 1σ of the gyro scale-factor error (dimensionless).
+    pub gyro_sigma: f64,
+    /// Steady-state 1σ of the accelerometer scale-factor error (dimensionless).
+    pub accel_sigma: f64,
+    /// Correlation time of both (s).
+    pub time_s: f64,
 }
 
 impl ProcessNoise {
@@ -53,18 +70,26 @@ impl ProcessNoise {
             accel_bias_sigma_m_s2: self.accel_bias_sigma_m_s2 * k,
             clock_bias_noise_m_per_sqrt_s: self.clock_bias_noise_m_per_sqrt_s * k,
             clock_drift_noise_m_s_per_sqrt_s: self.clock_drift_noise_m_s_per_sqrt_s * k,
+            wheel_scale_noise_per_sqrt_s: self.wheel_scale_noise_per_sqrt_s * k,
+            imu_scale: self.imu_scale.map(|s| ImuScaleNoise {
+                gyro_sigma: s.gyro_sigma * k,
+                accel_sigma: s.accel_sigma * k,
+                ..s
+            }),
             ..*self
         }
     }
 }
 
-/// The inputs the linearization needs: the nominal state and the bias-compensated
-/// specific force in the body frame over the interval.
+/// The inputs the linearization needs: the nominal state and the compensated specific
+/// force and angular rate in the body frame over the interval.
 #[derive(Debug, Clone, Copy)]
 pub struct LinearizationPoint {
     pub nav: NavState,
-    /// Bias-compensated specific force f_ib^b (m/s²).
+    /// Compensated specific force f_ib^b (m/s²).
     pub f_ib_b_m_s2: Vector3<f64>,
+    /// Compensated angular rate ω_ib^b (rad/s); used by the gyro scale-factor states only.
+    pub w_ib_b_rad_s: Vector3<f64>,
 }
 
 fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
@@ -184,6 +209,23 @@ pub fn system_matrix(lin: &LinearizationPoint, noise: &ProcessNoise) -> StateMat
         ACC_BIAS,
         &(-Matrix3::identity() / noise.accel_markov_time_s),
     );
+    // The scale factors: ω̂ − ω ≈ diag(ω̂) δs_g and f̂ − f ≈ diag(f̂) δs_a enter as the
+    // biases do; the wheel's factor is a random walk (no dynamics). Inert when off.
+    if let Some(scale) = noise.imu_scale {
+        let decay = -Matrix3::identity() / scale.time_s;
+        set(
+            PHI,
+            GYRO_SCALE,
+            &(-c_bn * Matrix3::from_diagonal(&lin.w_ib_b_rad_s)),
+        );
+        set(
+            DV,
+            ACC_SCALE,
+            &(c_bn * Matrix3::from_diagonal(&lin.f_ib_b_m_s2)),
+        );
+        set(GYRO_SCALE, GYRO_SCALE, &decay);
+        set(ACC_SCALE, ACC_SCALE, &decay);
+    }
     // Eq. (6): receiver clock.
     f[(CLOCK_BIAS, CLOCK_DRIFT)] = 1.0;
     f[(CLOCK_DRIFT, CLOCK_DRIFT)] = -1.0 / noise.clock_drift_time_s;
@@ -213,20 +255,25 @@ pub fn noise_density(noise: &ProcessNoise) -> StateVector {
         ACC_BIAS,
         2.0 * noise.accel_bias_sigma_m_s2.powi(2) / noise.accel_markov_time_s,
     );
+    if let Some(scale) = noise.imu_scale {
+        diag3(GYRO_SCALE, 2.0 * scale.gyro_sigma.powi(2) / scale.time_s);
+        diag3(ACC_SCALE, 2.0 * scale.accel_sigma.powi(2) / scale.time_s);
+    }
     q[CLOCK_BIAS] = noise.clock_bias_noise_m_per_sqrt_s.powi(2);
     q[CLOCK_DRIFT] = noise.clock_drift_noise_m_s_per_sqrt_s.powi(2);
+    q[WHEEL_SCALE] = noise.wheel_scale_noise_per_sqrt_s.powi(2);
     q
 }
 
-/// The non-zero pattern of F (about 85 of 400 entries), row by row, for cheap products with
-/// dense matrices; nothing is allocated per IMU sample.
+/// The non-zero pattern of F (about 85 of 729 entries with the scale factors off), row by
+/// row, for cheap products with dense matrices; nothing is allocated per IMU sample.
 struct SparseF<'a> {
     f: &'a StateMatrix,
-    /// Bit k of `rows[r]` is set when F[r, k] is not zero (N = 20 bits fit a u32).
+    /// Bit k of `rows[r]` is set when F[r, k] is not zero (N = 27 bits fit a u32).
     rows: [u32; N],
 }
 
-/// Rows of a 20 × 20 matrix, row r at index r.
+/// Rows of an N × N matrix, row r at index r.
 type Rows = [[f64; N]; N];
 
 impl<'a> SparseF<'a> {
@@ -242,7 +289,7 @@ impl<'a> SparseF<'a> {
     ///
     /// Math note (rounding): (F X)[r, c] is the sum of F[r, k] X[k, c] over the non-zero
     /// F[r, k] in increasing k, starting from zero, as a plain row-times-column product
-    /// that skips F's zeros would add them; a row's 20 sums run side by side.
+    /// that skips F's zeros would add them; a row's N sums run side by side.
     fn times(&self, x_rows: &StateMatrix, fx: &mut Rows) {
         let f = self.f.as_slice();
         let x = x_rows.as_slice();
@@ -336,6 +383,7 @@ mod tests {
                 q_nb: UnitQuaternion::identity(),
             },
             f_ib_b_m_s2: nalgebra::Vector3::new(0.1, 0.2, 9.8),
+            w_ib_b_rad_s: nalgebra::Vector3::new(0.01, -0.02, 0.3),
         };
         assert_eq!(system_matrix(&lin, &n), system_matrix(&lin, &s));
     }
@@ -351,6 +399,12 @@ mod tests {
             clock_bias_noise_m_per_sqrt_s: 0.5,
             clock_drift_noise_m_s_per_sqrt_s: 0.1,
             clock_drift_time_s: 1800.0,
+            wheel_scale_noise_per_sqrt_s: 1e-5,
+            imu_scale: Some(ImuScaleNoise {
+                gyro_sigma: 300e-6,
+                accel_sigma: 1000e-6,
+                time_s: 3600.0,
+            }),
         }
     }
 
@@ -363,6 +417,7 @@ mod tests {
                 q_nb: UnitQuaternion::from_euler_angles(0.02, -0.03, 1.1),
             },
             f_ib_b_m_s2: Vector3::new(0.8, -0.4, 9.81),
+            w_ib_b_rad_s: Vector3::new(0.01, -0.02, 0.3),
         }
     }
 
@@ -376,6 +431,8 @@ mod tests {
             (GYRO_BIAS, 2.4e-6),
             (GYRO_GM, 2.4e-6),
             (ACC_BIAS, 0.012),
+            (GYRO_SCALE, 300e-6),
+            (ACC_SCALE, 1000e-6),
         ];
         for (start, sigma) in values {
             for i in start..start + 3 {
@@ -385,6 +442,7 @@ mod tests {
         sigmas[DP + 2] = 5.0;
         sigmas[CLOCK_BIAS] = 30.0;
         sigmas[CLOCK_DRIFT] = 5.0;
+        sigmas[WHEEL_SCALE] = 0.05;
         let mut p = StateMatrix::from_diagonal(&sigmas.component_mul(&sigmas));
         // Some correlation, as after updates.
         p[(DV, PHI + 1)] = 0.3 * sigmas[DV] * sigmas[PHI + 1];
