@@ -7,7 +7,7 @@
 //! δV̇ = f^n × φ − (2ω_ie + ω_en) × δV + V × (2δω_ie + δω_en) + δg + C_b^n ∇ (the printed
 //! "−f^n × f^n" of eq. (2) is a typesetting slip for f^n × φ).
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
 use crate::earth::{self, Llh};
 use crate::ins::error_state::{
@@ -265,21 +265,24 @@ pub fn noise_density(noise: &ProcessNoise) -> StateVector {
     q
 }
 
-/// The non-zero pattern of F (about 85 of 729 entries with the scale factors off), row by
+/// A square matrix of the leading `M` states.
+type Square<const M: usize> = SMatrix<f64, M, M>;
+
+/// The non-zero pattern of F (about 85 of 400 entries of the paper's 20 states), row by
 /// row, for cheap products with dense matrices; nothing is allocated per IMU sample.
-struct SparseF<'a> {
-    f: &'a StateMatrix,
-    /// Bit k of `rows[r]` is set when F[r, k] is not zero (N = 27 bits fit a u32).
-    rows: [u32; N],
+struct SparseF<'a, const M: usize> {
+    f: &'a Square<M>,
+    /// Bit k of `rows[r]` is set when F[r, k] is not zero (M ≤ N = 27 bits fit a u32).
+    rows: [u32; M],
 }
 
-/// Rows of an N × N matrix, row r at index r.
-type Rows = [[f64; N]; N];
+/// Rows of an M × M matrix, row r at index r.
+type Rows<const M: usize> = [[f64; M]; M];
 
-impl<'a> SparseF<'a> {
-    fn new(f: &'a StateMatrix) -> Self {
+impl<'a, const M: usize> SparseF<'a, M> {
+    fn new(f: &'a Square<M>) -> Self {
         let rows = std::array::from_fn(|r| {
-            (0..N).fold(0u32, |mask, k| mask | (u32::from(f[(r, k)] != 0.0) << k))
+            (0..M).fold(0u32, |mask, k| mask | (u32::from(f[(r, k)] != 0.0) << k))
         });
         Self { f, rows }
     }
@@ -289,19 +292,19 @@ impl<'a> SparseF<'a> {
     ///
     /// Math note (rounding): (F X)[r, c] is the sum of F[r, k] X[k, c] over the non-zero
     /// F[r, k] in increasing k, starting from zero, as a plain row-times-column product
-    /// that skips F's zeros would add them; a row's N sums run side by side.
-    fn times(&self, x_rows: &StateMatrix, fx: &mut Rows) {
+    /// that skips F's zeros would add them; a row's M sums run side by side.
+    fn times(&self, x_rows: &Square<M>, fx: &mut Rows<M>) {
         let f = self.f.as_slice();
         let x = x_rows.as_slice();
         for (r, (row, &pattern)) in fx.iter_mut().zip(&self.rows).enumerate() {
-            let mut acc = [0.0; N];
+            let mut acc = [0.0; M];
             // The set bits from the lowest: k in increasing order.
             let mut mask = pattern;
             while mask != 0 {
                 let k = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
-                let v = f[r + N * k];
-                for (a, xc) in acc.iter_mut().zip(&x[k * N..(k + 1) * N]) {
+                let v = f[r + M * k];
+                for (a, xc) in acc.iter_mut().zip(&x[k * M..(k + 1) * M]) {
                     *a += v * xc;
                 }
             }
@@ -313,7 +316,7 @@ impl<'a> SparseF<'a> {
 /// The Lyapunov operator L(X) = F X + X Fᵀ = F X + (F X)ᵀ of a symmetric X, from the rows
 /// `fx` of F X. The result is exactly symmetric: L[i, j] and L[j, i] add the same two
 /// numbers, and floating-point addition is commutative.
-fn lyapunov(fx: &Rows, i: usize, j: usize) -> f64 {
+fn lyapunov<const M: usize>(fx: &Rows<M>, i: usize, j: usize) -> f64 {
     fx[i][j] + fx[j][i]
 }
 
@@ -330,18 +333,69 @@ fn lyapunov(fx: &Rows, i: usize, j: usize) -> f64 {
 /// covariant under a diagonal rescaling of the state, so states of very different units
 /// (radians of latitude, metres of clock) lose nothing to each other. The unit test
 /// checks it against the matrix exponential of Van Loan's block matrix.
+///
+/// Choice (inert states): when the trailing scale-factor states are inert (zero variance,
+/// rows of F and density: [`crate::ins::error_state`]'s Choice), the series runs
+/// on the leading 20 (or 21, the wheel's factor on) states only and the rest stays zero:
+/// the same numbers to the bit as the series on all N (a unit test compares them), at the
+/// cost of the paper's 20 states instead of 27 (docs/benchmarks.md).
 pub fn propagate_covariance(
     f: &StateMatrix,
     q_c: &StateVector,
     p: &StateMatrix,
     dt_s: f64,
 ) -> StateMatrix {
+    const PAPER: usize = CLOCK_DRIFT + 1;
+    const WITH_WHEEL: usize = WHEEL_SCALE + 1;
+    if inert_from(PAPER, f, q_c, p) {
+        on_leading::<PAPER>(f, q_c, p, dt_s)
+    } else if inert_from(WITH_WHEEL, f, q_c, p) {
+        on_leading::<WITH_WHEEL>(f, q_c, p, dt_s)
+    } else {
+        series(f, q_c, p, dt_s)
+    }
+}
+
+/// Whether every state from `first` on is inert: zero variance, density and row of F.
+///
+/// Math note: a zero variance of the positive semi-definite P makes its row and column
+/// zero, so F's columns of those states add exact zeros to F P and may be left out; a
+/// zero row of F and density keep them zero.
+fn inert_from(first: usize, f: &StateMatrix, q_c: &StateVector, p: &StateMatrix) -> bool {
+    (first..N).all(|i| q_c[i] == 0.0 && p[(i, i)] == 0.0 && (0..N).all(|j| f[(i, j)] == 0.0))
+}
+
+/// The series on the leading `M` states, the others zero.
+fn on_leading<const M: usize>(
+    f: &StateMatrix,
+    q_c: &StateVector,
+    p: &StateMatrix,
+    dt_s: f64,
+) -> StateMatrix {
+    let leading = series::<M>(
+        &f.fixed_view::<M, M>(0, 0).into_owned(),
+        &q_c.fixed_rows::<M>(0).into_owned(),
+        &p.fixed_view::<M, M>(0, 0).into_owned(),
+        dt_s,
+    );
+    let mut full = StateMatrix::zeros();
+    full.fixed_view_mut::<M, M>(0, 0).copy_from(&leading);
+    full
+}
+
+/// The series of [`propagate_covariance`] on M states.
+fn series<const M: usize>(
+    f: &Square<M>,
+    q_c: &SVector<f64, M>,
+    p: &Square<M>,
+    dt_s: f64,
+) -> Square<M> {
     let f_sparse = SparseF::new(f);
     // P is symmetric only up to rounding when it comes from outside: its rows are the
     // columns of Pᵀ. T₁ and T₂ are exactly symmetric, so they are their own row matrices.
-    let mut fx: Rows = [[0.0; N]; N];
+    let mut fx: Rows<M> = [[0.0; M]; M];
     f_sparse.times(&p.transpose(), &mut fx);
-    let t1 = StateMatrix::from_fn(|i, j| {
+    let t1 = Square::<M>::from_fn(|i, j| {
         let l = lyapunov(&fx, i, j);
         if i == j {
             l + q_c[i]
@@ -350,13 +404,13 @@ pub fn propagate_covariance(
         }
     });
     f_sparse.times(&t1, &mut fx);
-    let t2 = StateMatrix::from_fn(|i, j| lyapunov(&fx, i, j));
+    let t2 = Square::<M>::from_fn(|i, j| lyapunov(&fx, i, j));
     f_sparse.times(&t2, &mut fx);
     let (c1, c2, c3) = (dt_s, dt_s * dt_s * 0.5, dt_s.powi(3) / 6.0);
-    let p_new = StateMatrix::from_fn(|i, j| {
+    let p_new = Square::<M>::from_fn(|i, j| {
         p[(i, j)] + t1[(i, j)] * c1 + t2[(i, j)] * c2 + lyapunov(&fx, i, j) * c3
     });
-    StateMatrix::from_fn(|i, j| (p_new[(i, j)] + p_new[(j, i)]) * 0.5)
+    Square::<M>::from_fn(|i, j| (p_new[(i, j)] + p_new[(j, i)]) * 0.5)
 }
 
 #[cfg(test)]
@@ -494,6 +548,36 @@ mod tests {
                     assert_eq!(a.to_bits(), b.to_bits(), "dt {dt}: entry {i}: {a} vs {b}");
                 }
             }
+        }
+    }
+
+    #[test]
+    fn inert_scale_factors_leave_the_other_states_as_the_full_series_does() {
+        // Scale factors off: the leading-block path gives the full series' numbers to the
+        // bit, and the inert rows stay exactly zero; the wheel's factor alone likewise.
+        let off = ProcessNoise {
+            wheel_scale_noise_per_sqrt_s: 0.0,
+            imu_scale: None,
+            ..noise()
+        };
+        let wheel_only = ProcessNoise {
+            imu_scale: None,
+            ..noise()
+        };
+        for (noise, first_inert) in [(off, WHEEL_SCALE), (wheel_only, GYRO_SCALE)] {
+            let f = system_matrix(&moving_point(), &noise);
+            let q = noise_density(&noise);
+            let mut p0 = prior();
+            for i in first_inert..N {
+                p0.row_mut(i).fill(0.0);
+                p0.column_mut(i).fill(0.0);
+            }
+            let fast = propagate_covariance(&f, &q, &p0, 0.01);
+            let full = series(&f, &q, &p0, 0.01);
+            for (a, b) in fast.iter().zip(full.iter()) {
+                assert_eq!(a.to_bits(), b.to_bits());
+            }
+            assert!((first_inert..N).all(|i| fast.row(i).iter().all(|&v| v == 0.0)));
         }
     }
 

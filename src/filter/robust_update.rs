@@ -44,8 +44,8 @@
 //! overflowed within 300 s on both bases. With α = 1 the three forms coincide. The plain EKF without a scheme keeps [`ekf::update`] and its
 //! `filter.joseph_form` option.
 //!
-//! Choice (inert states): the schemes and the cubature base run on the states that are not
-//! inert ([`active_states`]: the optional scale factors when switched off, whose rows of
+//! Choice (inert states): the EKF, the schemes and the cubature base run on the states that
+//! are not inert ([`active_states`]: the optional scale factors when switched off, whose rows of
 //! P⁻ are zero); an inert state keeps a zero correction and zero rows of P⁺. The cubature
 //! rule needs a positive-definite P⁻, and with the inert states left out the update is,
 //! to the bit, the one of the state without them.
@@ -283,9 +283,17 @@ impl RobustUpdate {
         })
     }
 
-    /// The EKF of [`ekf::update`], unchanged (with its Joseph option).
+    /// The EKF of [`ekf::update`], unchanged (with its Joseph option), on the states that
+    /// are not inert.
     fn plain_ekf(&self, p: &StateMatrix, set: &MeasurementSet) -> Result<Correction, FilterError> {
-        let result = ekf::update(p, &set.h, &set.y, &set.r, self.joseph)?;
+        let sub = Subspace(active_states(p));
+        let result = ekf::update(
+            &sub.matrix(p),
+            &sub.columns(&set.h),
+            &set.y,
+            &set.r,
+            self.joseph,
+        )?;
         let m = set.y.len();
         let (_, prior_log_det_s) = normalized_squared(&set.y, &result.s);
         let outcome = UpdateOutcome {
@@ -302,8 +310,8 @@ impl RobustUpdate {
             robust_weights: DVector::from_element(m, f64::NAN),
         };
         Ok(Correction {
-            dx: result.dx,
-            p: result.p,
+            dx: sub.full_vector(&result.dx),
+            p: sub.full_matrix(&result.p),
             outcome,
         })
     }
