@@ -9,7 +9,7 @@ use adaptive_gnss_ins::engine::divergence::{Disagreement, DivergenceMonitor};
 use adaptive_gnss_ins::engine::update::{self, Pseudoranges};
 use adaptive_gnss_ins::engine::{process_noise, Adaptation, FilterState};
 use adaptive_gnss_ins::gnss::GnssEpoch;
-use adaptive_gnss_ins::ins::error_state::{StateMatrix, DP};
+use adaptive_gnss_ins::ins::error_state::{StateMatrix, StateVector, DP, WHEEL_SCALE};
 use adaptive_gnss_ins::ins::{ImuSample, NavState};
 use adaptive_gnss_ins::sim::constellation::{
     AtmosphereTruth, GpsConstellation, ObservationNoise, ReceiverTruth,
@@ -36,7 +36,17 @@ fn running_state(p: Llh) -> FilterState {
         accel_bias_m_s2: Vector3::zeros(),
         clock_bias_m: 100.0,
         clock_drift_mps: 1.0,
-        p: StateMatrix::identity() * 1e-2,
+        wheel_scale_factor: 1.0,
+        gyro_scale_error: Vector3::zeros(),
+        accel_scale_error: Vector3::zeros(),
+        // The default configuration: the optional scale-factor states inert.
+        p: StateMatrix::from_diagonal(&StateVector::from_fn(|i, _| {
+            if i < WHEEL_SCALE {
+                1e-2
+            } else {
+                0.0
+            }
+        })),
         prev_increment: None,
         last_imu: imu,
         phase_anchor: None,

@@ -7,7 +7,7 @@ use nalgebra::{SMatrix, SVector, UnitQuaternion, Vector3};
 use crate::adaptive::mahalanobis::chi_square_quantile;
 use crate::earth::{self, Llh};
 use crate::engine::Solution;
-use crate::ins::error_state::{DP, DV, PHI};
+use crate::ins::error_state::{DP, DV, N, PHI};
 
 /// One reference sample. Velocity and attitude are optional (a GNSS reference may have
 /// neither).
@@ -106,7 +106,7 @@ pub fn solution_error(solution: &Solution, truth: &TruthSample) -> SolutionError
     // Error vector and its covariance in (E, N, U, vE, vN, vU, φE, φN, φU), restricted to
     // what the reference has.
     let (north, east) = earth::metres_per_radian(&nav.p);
-    let mut t = SMatrix::<f64, 9, 20>::zeros();
+    let mut t = SMatrix::<f64, 9, N>::zeros();
     t[(0, DP + 1)] = east;
     t[(1, DP)] = north;
     t[(2, DP + 2)] = 1.0;

@@ -67,6 +67,10 @@ const EVERY_KEY_CHANGED: &str = "
       accel_range_g: 16.0
       gyro_max_step_deg_per_s: 0.0
       accel_max_step_g: 8.0
+      scale_factor_states: true
+      gyro_scale_factor_ppm: 500.0
+      accel_scale_factor_ppm: 700.0
+      scale_factor_correlation_time_s: 7200.0
     mounting:
       imu_rotation_rpy_deg: [1.5, -2.25, 179.0]
       antenna_lever_arm_m: [0.31, -0.12, 1.07]
@@ -88,6 +92,9 @@ const EVERY_KEY_CHANGED: &str = "
       enabled: true
       sigma_mps: 0.04
       scale_factor: 1.02
+      scale_factor_state: true
+      scale_factor_sigma: 0.02
+      scale_factor_noise_per_sqrt_s: 2e-5
     dual_antenna:
       enabled: true
       baseline_m: [0.1, -1.2, 0.05]

@@ -120,6 +120,26 @@ parameter_table! {
         accel_step_max_m_s2: f64 ["accel_max_step_g": f64] = 5.0,
             unit "g", range Range::OffOrWithin(Interval::above(0.0, 1e6)), at_run_time,
             si Scale::to("m/s^2", STANDARD_GRAVITY_M_S2);
+        /// Estimate the gyro and accelerometer scale-factor errors (six states of the
+        /// filter, first-order Gauss-Markov, as KF-GINS carries them): worth it where the
+        /// turns are long and the scale factors worse than the biases show (a 600 ppm gyro
+        /// scale error turns 360 deg of turning into 0.2 deg of heading). Off: the states
+        /// are inert and the outputs those of the filter without them.
+        scale_factor_states: bool = false, unit "", range ANY, at_start;
+        /// Steady-state (and initial) 1-sigma of the gyro scale-factor error, per axis.
+        gyro_scale_factor_sigma: f64 ["gyro_scale_factor_ppm": f64] = 1000.0,
+            unit "ppm", range SIGMA, at_start, si Scale::to("(ratio)", 1e-6);
+        /// Steady-state (and initial) 1-sigma of the accelerometer scale-factor error.
+        accel_scale_factor_sigma: f64 ["accel_scale_factor_ppm": f64] = 1000.0,
+            unit "ppm", range SIGMA, at_start, si Scale::to("(ratio)", 1e-6);
+        /// Correlation time of both scale-factor errors (a large value: a random
+        /// constant).
+        // Choice: 10 h, not KF-GINS's 1 h: a scale factor holds over a drive, and a 1 h
+        // Gauss-Markov process of the steady-state sigma above is driven by enough noise
+        // (2 sigma^2 / T) to forget in minutes what the turns teach (a 600 ppm gyro z error
+        // was learned to 205 ppm after six circles with 1 h, sigma still 384 ppm).
+        scale_factor_time_s: f64 ["scale_factor_correlation_time_s": f64] = 36000.0,
+            unit "s", range TIME_CONSTANT, at_start;
     }
 
     /// IMU orientation and antenna lever arm.
@@ -220,11 +240,20 @@ parameter_table! {
         enabled: bool = false, unit "", range ANY, at_start;
         /// 1-sigma of a speed whose message gives no variance (twist covariance[0] 0).
         sigma_mps: f64 = 0.1, unit "m/s", range SIGMA, at_start;
-        /// Fixed factor from the reported speed to the true one (a wheel radius off by 1 %:
-        /// 1.01). Applied to the speed and its sigma; not estimated.
+        /// Factor from the reported speed to the true one (a wheel radius off by 1 %:
+        /// 1.01): fixed, or the start of the estimate with scale_factor_state.
         // Choice: within [0.5, 2]: a factor beyond is a wrong unit or wheel, not a tyre.
         scale_factor: f64 = 1.0,
             unit "", range Range::Within(Interval::closed(0.5, 2.0)), at_start;
+        /// Estimate the scale factor (a state of the filter) while GNSS holds the velocity,
+        /// and use the estimate through outages; off: scale_factor is taken as exact.
+        scale_factor_state: bool = false, unit "", range ANY, at_start;
+        /// Initial 1-sigma of the scale factor with scale_factor_state (tyre wear and
+        /// pressure, a radius guessed from the data sheet).
+        scale_factor_sigma: f64 = 0.05, unit "", range SIGMA, at_start;
+        /// White noise driving the scale factor (a random walk) with scale_factor_state:
+        /// 1e-5 / sqrt(s) lets it move 6e-4 in an hour (tyres warming up, load).
+        scale_factor_noise_per_sqrt_s: f64 = 1e-5, unit "1/sqrt(s)", range SIGMA, at_start;
     }
 
     /// Dual-antenna heading (optional): a moving-base u-blox pair's relative position

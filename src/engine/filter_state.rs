@@ -7,7 +7,8 @@ use nalgebra::{UnitQuaternion, Vector3};
 
 use crate::filter::process_model::{self, LinearizationPoint, ProcessNoise};
 use crate::ins::error_state::{
-    StateMatrix, StateVector, ACC_BIAS, CLOCK_BIAS, CLOCK_DRIFT, DP, DV, GYRO_BIAS, GYRO_GM, PHI,
+    StateMatrix, StateVector, ACC_BIAS, ACC_SCALE, CLOCK_BIAS, CLOCK_DRIFT, DP, DV, GYRO_BIAS,
+    GYRO_GM, GYRO_SCALE, PHI, WHEEL_SCALE,
 };
 use crate::ins::mechanization::{self, ImuIncrement, MechanizationError};
 use crate::ins::{ImuSample, NavState};
@@ -27,6 +28,12 @@ pub struct FilterState {
     pub accel_bias_m_s2: Vector3<f64>,
     pub clock_bias_m: f64,
     pub clock_drift_mps: f64,
+    /// Wheel odometry scale factor: true forward speed per reported one (1 = exact).
+    pub wheel_scale_factor: f64,
+    /// Gyro scale-factor error s_g per axis (ω_meas = (1 + s_g) ω + bias).
+    pub gyro_scale_error: Vector3<f64>,
+    /// Accelerometer scale-factor error s_a per axis (f_meas = (1 + s_a) f + bias).
+    pub accel_scale_error: Vector3<f64>,
     pub p: StateMatrix,
     /// The previous IMU increment (for the coning and sculling corrections).
     pub prev_increment: Option<ImuIncrement>,
@@ -37,12 +44,20 @@ pub struct FilterState {
 }
 
 impl FilterState {
-    /// Removes the estimated sensor errors from a raw body-frame sample.
+    /// Removes the estimated sensor errors from a raw body-frame sample:
+    /// (raw − bias) / (1 + scale error), per axis.
     pub fn compensate(&self, raw: &ImuSample) -> ImuSample {
+        let unscale = |x: Vector3<f64>, s: &Vector3<f64>| x.component_div(&s.add_scalar(1.0));
         ImuSample {
             t_s: raw.t_s,
-            w_ib_b_rad_s: raw.w_ib_b_rad_s - self.gyro_bias_rad_s - self.gyro_markov_rad_s,
-            f_ib_b_m_s2: raw.f_ib_b_m_s2 - self.accel_bias_m_s2,
+            w_ib_b_rad_s: unscale(
+                raw.w_ib_b_rad_s - self.gyro_bias_rad_s - self.gyro_markov_rad_s,
+                &self.gyro_scale_error,
+            ),
+            f_ib_b_m_s2: unscale(
+                raw.f_ib_b_m_s2 - self.accel_bias_m_s2,
+                &self.accel_scale_error,
+            ),
         }
     }
 
@@ -61,6 +76,7 @@ impl FilterState {
         let lin = LinearizationPoint {
             nav: self.nav,
             f_ib_b_m_s2: increment.dv_b_m_s / dt,
+            w_ib_b_rad_s: increment.dtheta_b_rad / dt,
         };
         let f = process_model::system_matrix(&lin, noise);
         let q_c = process_model::noise_density(noise);
@@ -71,6 +87,11 @@ impl FilterState {
         self.accel_bias_m_s2 *= (-dt / noise.accel_markov_time_s).exp();
         self.clock_bias_m += self.clock_drift_mps * dt;
         self.clock_drift_mps *= (-dt / noise.clock_drift_time_s).exp();
+        if let Some(scale) = noise.imu_scale {
+            let decay = (-dt / scale.time_s).exp();
+            self.gyro_scale_error *= decay;
+            self.accel_scale_error *= decay;
+        }
         self.prev_increment = Some(increment);
         self.last_imu = *next;
         Ok(())
@@ -93,6 +114,9 @@ impl FilterState {
         self.accel_bias_m_s2 += dx.fixed_rows::<3>(ACC_BIAS);
         self.clock_bias_m -= dx[CLOCK_BIAS];
         self.clock_drift_mps -= dx[CLOCK_DRIFT];
+        self.wheel_scale_factor += dx[WHEEL_SCALE];
+        self.gyro_scale_error += dx.fixed_rows::<3>(GYRO_SCALE);
+        self.accel_scale_error += dx.fixed_rows::<3>(ACC_SCALE);
     }
 
     /// The error state δx that [`Self::apply_correction`] would take from `self` to
@@ -115,6 +139,11 @@ impl FilterState {
             .copy_from(&(corrected.accel_bias_m_s2 - self.accel_bias_m_s2));
         dx[CLOCK_BIAS] = self.clock_bias_m - corrected.clock_bias_m;
         dx[CLOCK_DRIFT] = self.clock_drift_mps - corrected.clock_drift_mps;
+        dx[WHEEL_SCALE] = corrected.wheel_scale_factor - self.wheel_scale_factor;
+        dx.fixed_rows_mut::<3>(GYRO_SCALE)
+            .copy_from(&(corrected.gyro_scale_error - self.gyro_scale_error));
+        dx.fixed_rows_mut::<3>(ACC_SCALE)
+            .copy_from(&(corrected.accel_scale_error - self.accel_scale_error));
         dx
     }
 
@@ -126,6 +155,9 @@ impl FilterState {
             && self.accel_bias_m_s2.iter().all(|v| v.is_finite())
             && self.clock_bias_m.is_finite()
             && self.clock_drift_mps.is_finite()
+            && self.wheel_scale_factor.is_finite()
+            && self.gyro_scale_error.iter().all(|v| v.is_finite())
+            && self.accel_scale_error.iter().all(|v| v.is_finite())
             && self.p.iter().all(|v| v.is_finite())
     }
 

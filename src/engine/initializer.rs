@@ -36,7 +36,8 @@ use crate::earth::{self, Llh};
 use crate::gnss::spp::{self, SppConfig};
 use crate::gnss::GnssEpoch;
 use crate::ins::error_state::{
-    StateMatrix, ACC_BIAS, CLOCK_BIAS, CLOCK_DRIFT, DP, DV, GYRO_BIAS, GYRO_GM, PHI,
+    StateMatrix, ACC_BIAS, ACC_SCALE, CLOCK_BIAS, CLOCK_DRIFT, DP, DV, GYRO_BIAS, GYRO_GM,
+    GYRO_SCALE, PHI, WHEEL_SCALE,
 };
 use crate::ins::{ImuSample, NavState};
 
@@ -662,6 +663,18 @@ impl Initializer {
         set3(&mut cov, ACC_BIAS, [ab, ab, ab]);
         cov[(CLOCK_BIAS, CLOCK_BIAS)] = i.clock_bias_sigma_m.powi(2);
         cov[(CLOCK_DRIFT, CLOCK_DRIFT)] = i.clock_drift_sigma_mps.powi(2);
+        // The optional scale factors: inert (zero variance) when off.
+        if config.wheel_odometry.scale_factor_state {
+            cov[(WHEEL_SCALE, WHEEL_SCALE)] = config.wheel_odometry.scale_factor_sigma.powi(2);
+        }
+        if config.imu.scale_factor_states {
+            let (g, a) = (
+                config.imu.gyro_scale_factor_sigma.powi(2),
+                config.imu.accel_scale_factor_sigma.powi(2),
+            );
+            set3(&mut cov, GYRO_SCALE, [g, g, g]);
+            set3(&mut cov, ACC_SCALE, [a, a, a]);
+        }
         // The bias at rest is the mean rate less the earth rate seen in the body frame,
         // which needs the heading: the levelled attitude turned by the yaw found since. An
         // alignment in motion has no bias (zero, with the class's σ above).

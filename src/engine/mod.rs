@@ -61,7 +61,7 @@ mod wheel_odometry;
 use std::collections::VecDeque;
 
 use crate::config::{Config, Coupling};
-use crate::filter::process_model::ProcessNoise;
+use crate::filter::process_model::{ImuScaleNoise, ProcessNoise};
 use crate::gnss::GnssEpoch;
 use crate::ins::ImuSample;
 
@@ -728,5 +728,15 @@ pub fn process_noise(config: &Config) -> ProcessNoise {
         clock_bias_noise_m_per_sqrt_s: config.clock.bias_noise_m_per_sqrt_s,
         clock_drift_noise_m_s_per_sqrt_s: config.clock.drift_noise_m_s_per_sqrt_s,
         clock_drift_time_s: config.clock.drift_time_s,
+        wheel_scale_noise_per_sqrt_s: if config.wheel_odometry.scale_factor_state {
+            config.wheel_odometry.scale_factor_noise_per_sqrt_s
+        } else {
+            0.0
+        },
+        imu_scale: config.imu.scale_factor_states.then_some(ImuScaleNoise {
+            gyro_sigma: config.imu.gyro_scale_factor_sigma,
+            accel_sigma: config.imu.accel_scale_factor_sigma,
+            time_s: config.imu.scale_factor_time_s,
+        }),
     }
 }

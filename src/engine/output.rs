@@ -5,7 +5,7 @@ use nalgebra::{Matrix3, SMatrix, Vector3};
 
 use crate::earth::{self, Llh};
 use crate::gnss::SatId;
-use crate::ins::error_state::{StateMatrix, DP, DV, PHI};
+use crate::ins::error_state::{StateMatrix, DP, DV, N, PHI};
 use crate::ins::NavState;
 
 /// One navigation solution at an IMU time.
@@ -46,7 +46,7 @@ impl Solution {
     /// 6×6 pose covariance (E, N, U, rotation about E, N, U), in the ROS pose order.
     pub fn pose_covariance_enu(&self) -> SMatrix<f64, 6, 6> {
         let (north, east) = earth::metres_per_radian(&self.nav.p);
-        let mut t = SMatrix::<f64, 6, 20>::zeros();
+        let mut t = SMatrix::<f64, 6, N>::zeros();
         t[(0, DP + 1)] = east;
         t[(1, DP)] = north;
         t[(2, DP + 2)] = 1.0;

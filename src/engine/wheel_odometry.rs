@@ -24,15 +24,16 @@ impl WheelSpeedReading {
             && self.sigma_mps.is_none_or(|s| s.is_finite() && s > 0.0)
     }
 
-    /// The measurement of the point `mounting.constraint_point_lever_arm_m`, with
-    /// `wheel_odometry.scale_factor` applied to the speed and its σ.
+    /// The measurement of the point `mounting.constraint_point_lever_arm_m`, as reported:
+    /// the filter state's wheel scale factor (`wheel_odometry.scale_factor`, fixed or
+    /// estimated) turns it into the true speed.
     pub fn model<'a>(&self, config: &'a Config) -> WheelSpeed<'a> {
         let w = &config.wheel_odometry;
         WheelSpeed {
             t_s: self.t_s,
             lever_arm_b_m: &config.mounting.constraint_point_b_m,
-            speed_mps: w.scale_factor * self.speed_mps,
-            sigma_mps: w.scale_factor * self.sigma_mps.unwrap_or(w.sigma_mps),
+            speed_mps: self.speed_mps,
+            sigma_mps: self.sigma_mps.unwrap_or(w.sigma_mps),
         }
     }
 }

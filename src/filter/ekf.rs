@@ -4,7 +4,8 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::ins::error_state::{StateMatrix, StateVector, N};
+use crate::ins::error_state::N;
+use crate::linalg::symmetrize;
 
 /// Failures of a Kalman step; the state is left untouched when one is returned.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -35,40 +36,43 @@ pub enum FilterError {
     Linalg(#[from] crate::linalg::LinalgError),
 }
 
-/// (A + Aᵀ)/2.
-pub fn symmetrize(p: &StateMatrix) -> StateMatrix {
-    (p + p.transpose()) * 0.5
-}
-
 /// The result of a measurement update.
 #[derive(Debug, Clone)]
 pub struct Update {
     /// Error-state estimate δx̂ = K y.
-    pub dx: StateVector,
+    pub dx: DVector<f64>,
     /// Posterior covariance.
-    pub p: StateMatrix,
+    pub p: DMatrix<f64>,
     /// Innovation covariance S = H P⁻ Hᵀ + R.
     pub s: DMatrix<f64>,
     /// Normalized innovation squared yᵀ S⁻¹ y.
     pub nis: f64,
 }
 
-/// Measurement update, eq. (11), with the innovation `y` (m), rows `h` (m × N) and noise
-/// covariance `r` (m × m).
+/// Measurement update, eq. (11), of the prior covariance `p` (n × n: the error state, or
+/// the part of it that is not inert) with the innovation `y` (m), rows `h` (m × n) and
+/// noise covariance `r` (m × m).
 ///
 /// Math note: the covariance uses Joseph's form (I − KH) P (I − KH)ᵀ + K R Kᵀ when `joseph`
 /// is set, which stays symmetric positive semi-definite for any gain; the short form
 /// (I − KH) P of eq. (11) is kept as an option for comparison with the paper. K is formed
 /// by a Cholesky solve with S, never an explicit inverse.
 pub fn update(
-    p: &StateMatrix,
+    p: &DMatrix<f64>,
     h: &DMatrix<f64>,
     y: &DVector<f64>,
     r: &DMatrix<f64>,
     joseph: bool,
 ) -> Result<Update, FilterError> {
     let m = y.len();
-    if h.nrows() != m || h.ncols() != N || r.nrows() != m || r.ncols() != m {
+    let n = p.nrows();
+    if p.ncols() != n
+        || n > N
+        || h.nrows() != m
+        || h.ncols() != n
+        || r.nrows() != m
+        || r.ncols() != m
+    {
         return Err(FilterError::DimensionMismatch {
             h_rows: h.nrows(),
             h_cols: h.ncols(),
@@ -77,8 +81,8 @@ pub fn update(
             r_cols: r.ncols(),
         });
     }
-    let p_dyn = DMatrix::from_column_slice(N, N, p.as_slice());
-    let pht = &p_dyn * h.transpose();
+    let p_dyn = p;
+    let pht = p_dyn * h.transpose();
     let mut s = h * &pht + r;
     s = (&s + s.transpose()) * 0.5;
     let chol = s
@@ -89,15 +93,14 @@ pub fn update(
     let k = kalman_gain(chol.l_dirty(), &pht);
     let dx_dyn = &k * y;
     let nis = y.dot(&chol.solve(y));
-    let i_kh = DMatrix::<f64>::identity(N, N) - &k * h;
+    let i_kh = DMatrix::<f64>::identity(n, n) - &k * h;
     let p_post = if joseph {
-        &i_kh * &p_dyn * i_kh.transpose() + k_r_kt(&k, r)
+        &i_kh * p_dyn * i_kh.transpose() + k_r_kt(&k, r)
     } else {
-        &i_kh * &p_dyn
+        &i_kh * p_dyn
     };
-    let p_post = StateMatrix::from_column_slice(p_post.as_slice());
     let p_post = symmetrize(&p_post);
-    let dx = StateVector::from_column_slice(dx_dyn.as_slice());
+    let dx = dx_dyn;
     if !(dx.iter().all(|v| v.is_finite())
         && p_post.iter().all(|v| v.is_finite())
         && nis.is_finite())
@@ -113,8 +116,8 @@ pub fn update(
 }
 
 /// The gain K = P Hᵀ S⁻¹ from the lower Cholesky factor `l` of S = L Lᵀ (only its lower
-/// triangle is read) and P Hᵀ (N × m): S Kᵀ = H P solved by forward substitution
-/// L Z = H P and back substitution Lᵀ Kᵀ = Z, for all N right-hand sides at once.
+/// triangle is read) and P Hᵀ (n × m, n ≤ N): S Kᵀ = H P solved by forward substitution
+/// L Z = H P and back substitution Lᵀ Kᵀ = Z, for all n right-hand sides at once.
 ///
 /// Math note (layout): row i of H P is column i of P Hᵀ and row i of Kᵀ is column i of K,
 /// both contiguous, so each step of either substitution updates N numbers side by side.
@@ -122,34 +125,36 @@ pub fn update(
 /// substitution sums Σ_{j>i} L[j, i] x_j in increasing j (a column-by-column solve may
 /// group that sum differently: the two agree to rounding).
 fn kalman_gain(l: &DMatrix<f64>, pht: &DMatrix<f64>) -> DMatrix<f64> {
-    let m = pht.ncols();
+    let (n, m) = pht.shape();
     let mut k = pht.clone();
     let ks = k.as_mut_slice();
     for i in 0..m {
-        let mut acc = [0.0; N];
-        acc.copy_from_slice(&ks[i * N..(i + 1) * N]);
+        let mut acc_n = [0.0; N];
+        let acc = &mut acc_n[..n];
+        acc.copy_from_slice(&ks[i * n..(i + 1) * n]);
         for j in 0..i {
             let l_ij = l[(i, j)];
-            for (a, z) in acc.iter_mut().zip(&ks[j * N..(j + 1) * N]) {
+            for (a, z) in acc.iter_mut().zip(&ks[j * n..(j + 1) * n]) {
                 *a -= l_ij * z;
             }
         }
         let d = l[(i, i)];
-        for (out, a) in ks[i * N..(i + 1) * N].iter_mut().zip(&acc) {
+        for (out, a) in ks[i * n..(i + 1) * n].iter_mut().zip(acc.iter()) {
             *out = a / d;
         }
     }
     for i in (0..m).rev() {
-        let mut acc = [0.0; N];
-        acc.copy_from_slice(&ks[i * N..(i + 1) * N]);
+        let mut acc_n = [0.0; N];
+        let acc = &mut acc_n[..n];
+        acc.copy_from_slice(&ks[i * n..(i + 1) * n]);
         for j in i + 1..m {
             let l_ji = l[(j, i)];
-            for (a, x) in acc.iter_mut().zip(&ks[j * N..(j + 1) * N]) {
+            for (a, x) in acc.iter_mut().zip(&ks[j * n..(j + 1) * n]) {
                 *a -= l_ji * x;
             }
         }
         let d = l[(i, i)];
-        for (out, a) in ks[i * N..(i + 1) * N].iter_mut().zip(&acc) {
+        for (out, a) in ks[i * n..(i + 1) * n].iter_mut().zip(acc.iter()) {
             *out = a / d;
         }
     }
@@ -178,7 +183,7 @@ mod tests {
 
     #[test]
     fn scalar_update_matches_closed_form() {
-        let mut p = StateMatrix::identity() * 4.0;
+        let mut p = DMatrix::identity(N, N) * 4.0;
         p[(0, 1)] = 1.0;
         p[(1, 0)] = 1.0;
         let mut h = DMatrix::zeros(1, N);
@@ -212,7 +217,7 @@ mod tests {
     #[test]
     fn kalman_gain_matches_the_generic_cholesky_solve() {
         // A P and 24 rows H of the sizes of a 12-satellite epoch.
-        let p = StateMatrix::from_fn(|i, j| {
+        let p = crate::ins::error_state::StateMatrix::from_fn(|i, j| {
             let d = (i as f64 - j as f64).abs();
             (1.0 + 0.3 * i as f64) * (1.0 + 0.3 * j as f64) * (-0.4 * d).exp()
         });
@@ -230,7 +235,7 @@ mod tests {
 
     #[test]
     fn rejects_singular_innovation_covariance() {
-        let p = StateMatrix::zeros();
+        let p = DMatrix::zeros(N, N);
         let h = DMatrix::zeros(2, N);
         let y = DVector::zeros(2);
         let r = DMatrix::zeros(2, 2);

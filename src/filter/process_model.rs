@@ -7,11 +7,12 @@
 //! δV̇ = f^n × φ − (2ω_ie + ω_en) × δV + V × (2δω_ie + δω_en) + δg + C_b^n ∇ (the printed
 //! "−f^n × f^n" of eq. (2) is a typesetting slip for f^n × φ).
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
 use crate::earth::{self, Llh};
 use crate::ins::error_state::{
-    StateMatrix, StateVector, ACC_BIAS, CLOCK_BIAS, CLOCK_DRIFT, DP, DV, GYRO_BIAS, GYRO_GM, N, PHI,
+    StateMatrix, StateVector, ACC_BIAS, ACC_SCALE, CLOCK_BIAS, CLOCK_DRIFT, DP, DV, GYRO_BIAS,
+    GYRO_GM, GYRO_SCALE, N, PHI, WHEEL_SCALE,
 };
 use crate::ins::NavState;
 
@@ -36,6 +37,22 @@ pub struct ProcessNoise {
     pub clock_drift_noise_m_s_per_sqrt_s: f64,
     /// Correlation time T_ru of the clock drift (s).
     pub clock_drift_time_s: f64,
+    /// White noise driving the wheel odometry scale factor (a random walk, 1/√s); zero
+    /// when the state is off.
+    pub wheel_scale_noise_per_sqrt_s: f64,
+    /// The IMU scale-factor states (`imu.scale_factor_states`); None: inert.
+    pub imu_scale: Option<ImuScaleNoise>,
+}
+
+/// First-order Gauss-Markov models of the IMU scale-factor errors (as KF-GINS carries them).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImuScaleNoise {
+    /// Steady-state 1σ of the gyro scale-factor error (dimensionless).
+    pub gyro_sigma: f64,
+    /// Steady-state 1σ of the accelerometer scale-factor error (dimensionless).
+    pub accel_sigma: f64,
+    /// Correlation time of both (s).
+    pub time_s: f64,
 }
 
 impl ProcessNoise {
@@ -53,18 +70,26 @@ impl ProcessNoise {
             accel_bias_sigma_m_s2: self.accel_bias_sigma_m_s2 * k,
             clock_bias_noise_m_per_sqrt_s: self.clock_bias_noise_m_per_sqrt_s * k,
             clock_drift_noise_m_s_per_sqrt_s: self.clock_drift_noise_m_s_per_sqrt_s * k,
+            wheel_scale_noise_per_sqrt_s: self.wheel_scale_noise_per_sqrt_s * k,
+            imu_scale: self.imu_scale.map(|s| ImuScaleNoise {
+                gyro_sigma: s.gyro_sigma * k,
+                accel_sigma: s.accel_sigma * k,
+                ..s
+            }),
             ..*self
         }
     }
 }
 
-/// The inputs the linearization needs: the nominal state and the bias-compensated
-/// specific force in the body frame over the interval.
+/// The inputs the linearization needs: the nominal state and the compensated specific
+/// force and angular rate in the body frame over the interval.
 #[derive(Debug, Clone, Copy)]
 pub struct LinearizationPoint {
     pub nav: NavState,
-    /// Bias-compensated specific force f_ib^b (m/s²).
+    /// Compensated specific force f_ib^b (m/s²).
     pub f_ib_b_m_s2: Vector3<f64>,
+    /// Compensated angular rate ω_ib^b (rad/s); used by the gyro scale-factor states only.
+    pub w_ib_b_rad_s: Vector3<f64>,
 }
 
 fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
@@ -184,6 +209,23 @@ pub fn system_matrix(lin: &LinearizationPoint, noise: &ProcessNoise) -> StateMat
         ACC_BIAS,
         &(-Matrix3::identity() / noise.accel_markov_time_s),
     );
+    // The scale factors: ω̂ − ω ≈ diag(ω̂) δs_g and f̂ − f ≈ diag(f̂) δs_a enter as the
+    // biases do; the wheel's factor is a random walk (no dynamics). Inert when off.
+    if let Some(scale) = noise.imu_scale {
+        let decay = -Matrix3::identity() / scale.time_s;
+        set(
+            PHI,
+            GYRO_SCALE,
+            &(-c_bn * Matrix3::from_diagonal(&lin.w_ib_b_rad_s)),
+        );
+        set(
+            DV,
+            ACC_SCALE,
+            &(c_bn * Matrix3::from_diagonal(&lin.f_ib_b_m_s2)),
+        );
+        set(GYRO_SCALE, GYRO_SCALE, &decay);
+        set(ACC_SCALE, ACC_SCALE, &decay);
+    }
     // Eq. (6): receiver clock.
     f[(CLOCK_BIAS, CLOCK_DRIFT)] = 1.0;
     f[(CLOCK_DRIFT, CLOCK_DRIFT)] = -1.0 / noise.clock_drift_time_s;
@@ -213,26 +255,34 @@ pub fn noise_density(noise: &ProcessNoise) -> StateVector {
         ACC_BIAS,
         2.0 * noise.accel_bias_sigma_m_s2.powi(2) / noise.accel_markov_time_s,
     );
+    if let Some(scale) = noise.imu_scale {
+        diag3(GYRO_SCALE, 2.0 * scale.gyro_sigma.powi(2) / scale.time_s);
+        diag3(ACC_SCALE, 2.0 * scale.accel_sigma.powi(2) / scale.time_s);
+    }
     q[CLOCK_BIAS] = noise.clock_bias_noise_m_per_sqrt_s.powi(2);
     q[CLOCK_DRIFT] = noise.clock_drift_noise_m_s_per_sqrt_s.powi(2);
+    q[WHEEL_SCALE] = noise.wheel_scale_noise_per_sqrt_s.powi(2);
     q
 }
 
-/// The non-zero pattern of F (about 85 of 400 entries), row by row, for cheap products with
-/// dense matrices; nothing is allocated per IMU sample.
-struct SparseF<'a> {
-    f: &'a StateMatrix,
-    /// Bit k of `rows[r]` is set when F[r, k] is not zero (N = 20 bits fit a u32).
-    rows: [u32; N],
+/// A square matrix of the leading `M` states.
+type Square<const M: usize> = SMatrix<f64, M, M>;
+
+/// The non-zero pattern of F (about 85 of 400 entries of the paper's 20 states), row by
+/// row, for cheap products with dense matrices; nothing is allocated per IMU sample.
+struct SparseF<'a, const M: usize> {
+    f: &'a Square<M>,
+    /// Bit k of `rows[r]` is set when F[r, k] is not zero (M ≤ N = 27 bits fit a u32).
+    rows: [u32; M],
 }
 
-/// Rows of a 20 × 20 matrix, row r at index r.
-type Rows = [[f64; N]; N];
+/// Rows of an M × M matrix, row r at index r.
+type Rows<const M: usize> = [[f64; M]; M];
 
-impl<'a> SparseF<'a> {
-    fn new(f: &'a StateMatrix) -> Self {
+impl<'a, const M: usize> SparseF<'a, M> {
+    fn new(f: &'a Square<M>) -> Self {
         let rows = std::array::from_fn(|r| {
-            (0..N).fold(0u32, |mask, k| mask | (u32::from(f[(r, k)] != 0.0) << k))
+            (0..M).fold(0u32, |mask, k| mask | (u32::from(f[(r, k)] != 0.0) << k))
         });
         Self { f, rows }
     }
@@ -242,19 +292,19 @@ impl<'a> SparseF<'a> {
     ///
     /// Math note (rounding): (F X)[r, c] is the sum of F[r, k] X[k, c] over the non-zero
     /// F[r, k] in increasing k, starting from zero, as a plain row-times-column product
-    /// that skips F's zeros would add them; a row's 20 sums run side by side.
-    fn times(&self, x_rows: &StateMatrix, fx: &mut Rows) {
+    /// that skips F's zeros would add them; a row's M sums run side by side.
+    fn times(&self, x_rows: &Square<M>, fx: &mut Rows<M>) {
         let f = self.f.as_slice();
         let x = x_rows.as_slice();
         for (r, (row, &pattern)) in fx.iter_mut().zip(&self.rows).enumerate() {
-            let mut acc = [0.0; N];
+            let mut acc = [0.0; M];
             // The set bits from the lowest: k in increasing order.
             let mut mask = pattern;
             while mask != 0 {
                 let k = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
-                let v = f[r + N * k];
-                for (a, xc) in acc.iter_mut().zip(&x[k * N..(k + 1) * N]) {
+                let v = f[r + M * k];
+                for (a, xc) in acc.iter_mut().zip(&x[k * M..(k + 1) * M]) {
                     *a += v * xc;
                 }
             }
@@ -266,7 +316,7 @@ impl<'a> SparseF<'a> {
 /// The Lyapunov operator L(X) = F X + X Fᵀ = F X + (F X)ᵀ of a symmetric X, from the rows
 /// `fx` of F X. The result is exactly symmetric: L[i, j] and L[j, i] add the same two
 /// numbers, and floating-point addition is commutative.
-fn lyapunov(fx: &Rows, i: usize, j: usize) -> f64 {
+fn lyapunov<const M: usize>(fx: &Rows<M>, i: usize, j: usize) -> f64 {
     fx[i][j] + fx[j][i]
 }
 
@@ -283,18 +333,69 @@ fn lyapunov(fx: &Rows, i: usize, j: usize) -> f64 {
 /// covariant under a diagonal rescaling of the state, so states of very different units
 /// (radians of latitude, metres of clock) lose nothing to each other. The unit test
 /// checks it against the matrix exponential of Van Loan's block matrix.
+///
+/// Choice (inert states): when the trailing scale-factor states are inert (zero variance,
+/// rows of F and density: [`crate::ins::error_state`]'s Choice), the series runs
+/// on the leading 20 (or 21, the wheel's factor on) states only and the rest stays zero:
+/// the same numbers to the bit as the series on all N (a unit test compares them), at the
+/// cost of the paper's 20 states instead of 27 (docs/benchmarks.md).
 pub fn propagate_covariance(
     f: &StateMatrix,
     q_c: &StateVector,
     p: &StateMatrix,
     dt_s: f64,
 ) -> StateMatrix {
+    const PAPER: usize = CLOCK_DRIFT + 1;
+    const WITH_WHEEL: usize = WHEEL_SCALE + 1;
+    if inert_from(PAPER, f, q_c, p) {
+        on_leading::<PAPER>(f, q_c, p, dt_s)
+    } else if inert_from(WITH_WHEEL, f, q_c, p) {
+        on_leading::<WITH_WHEEL>(f, q_c, p, dt_s)
+    } else {
+        series(f, q_c, p, dt_s)
+    }
+}
+
+/// Whether every state from `first` on is inert: zero variance, density and row of F.
+///
+/// Math note: a zero variance of the positive semi-definite P makes its row and column
+/// zero, so F's columns of those states add exact zeros to F P and may be left out; a
+/// zero row of F and density keep them zero.
+fn inert_from(first: usize, f: &StateMatrix, q_c: &StateVector, p: &StateMatrix) -> bool {
+    (first..N).all(|i| q_c[i] == 0.0 && p[(i, i)] == 0.0 && (0..N).all(|j| f[(i, j)] == 0.0))
+}
+
+/// The series on the leading `M` states, the others zero.
+fn on_leading<const M: usize>(
+    f: &StateMatrix,
+    q_c: &StateVector,
+    p: &StateMatrix,
+    dt_s: f64,
+) -> StateMatrix {
+    let leading = series::<M>(
+        &f.fixed_view::<M, M>(0, 0).into_owned(),
+        &q_c.fixed_rows::<M>(0).into_owned(),
+        &p.fixed_view::<M, M>(0, 0).into_owned(),
+        dt_s,
+    );
+    let mut full = StateMatrix::zeros();
+    full.fixed_view_mut::<M, M>(0, 0).copy_from(&leading);
+    full
+}
+
+/// The series of [`propagate_covariance`] on M states.
+fn series<const M: usize>(
+    f: &Square<M>,
+    q_c: &SVector<f64, M>,
+    p: &Square<M>,
+    dt_s: f64,
+) -> Square<M> {
     let f_sparse = SparseF::new(f);
     // P is symmetric only up to rounding when it comes from outside: its rows are the
     // columns of Pᵀ. T₁ and T₂ are exactly symmetric, so they are their own row matrices.
-    let mut fx: Rows = [[0.0; N]; N];
+    let mut fx: Rows<M> = [[0.0; M]; M];
     f_sparse.times(&p.transpose(), &mut fx);
-    let t1 = StateMatrix::from_fn(|i, j| {
+    let t1 = Square::<M>::from_fn(|i, j| {
         let l = lyapunov(&fx, i, j);
         if i == j {
             l + q_c[i]
@@ -303,13 +404,13 @@ pub fn propagate_covariance(
         }
     });
     f_sparse.times(&t1, &mut fx);
-    let t2 = StateMatrix::from_fn(|i, j| lyapunov(&fx, i, j));
+    let t2 = Square::<M>::from_fn(|i, j| lyapunov(&fx, i, j));
     f_sparse.times(&t2, &mut fx);
     let (c1, c2, c3) = (dt_s, dt_s * dt_s * 0.5, dt_s.powi(3) / 6.0);
-    let p_new = StateMatrix::from_fn(|i, j| {
+    let p_new = Square::<M>::from_fn(|i, j| {
         p[(i, j)] + t1[(i, j)] * c1 + t2[(i, j)] * c2 + lyapunov(&fx, i, j) * c3
     });
-    StateMatrix::from_fn(|i, j| (p_new[(i, j)] + p_new[(j, i)]) * 0.5)
+    Square::<M>::from_fn(|i, j| (p_new[(i, j)] + p_new[(j, i)]) * 0.5)
 }
 
 #[cfg(test)]
@@ -336,6 +437,7 @@ mod tests {
                 q_nb: UnitQuaternion::identity(),
             },
             f_ib_b_m_s2: nalgebra::Vector3::new(0.1, 0.2, 9.8),
+            w_ib_b_rad_s: nalgebra::Vector3::new(0.01, -0.02, 0.3),
         };
         assert_eq!(system_matrix(&lin, &n), system_matrix(&lin, &s));
     }
@@ -351,6 +453,12 @@ mod tests {
             clock_bias_noise_m_per_sqrt_s: 0.5,
             clock_drift_noise_m_s_per_sqrt_s: 0.1,
             clock_drift_time_s: 1800.0,
+            wheel_scale_noise_per_sqrt_s: 1e-5,
+            imu_scale: Some(ImuScaleNoise {
+                gyro_sigma: 300e-6,
+                accel_sigma: 1000e-6,
+                time_s: 3600.0,
+            }),
         }
     }
 
@@ -363,6 +471,7 @@ mod tests {
                 q_nb: UnitQuaternion::from_euler_angles(0.02, -0.03, 1.1),
             },
             f_ib_b_m_s2: Vector3::new(0.8, -0.4, 9.81),
+            w_ib_b_rad_s: Vector3::new(0.01, -0.02, 0.3),
         }
     }
 
@@ -376,6 +485,8 @@ mod tests {
             (GYRO_BIAS, 2.4e-6),
             (GYRO_GM, 2.4e-6),
             (ACC_BIAS, 0.012),
+            (GYRO_SCALE, 300e-6),
+            (ACC_SCALE, 1000e-6),
         ];
         for (start, sigma) in values {
             for i in start..start + 3 {
@@ -385,6 +496,7 @@ mod tests {
         sigmas[DP + 2] = 5.0;
         sigmas[CLOCK_BIAS] = 30.0;
         sigmas[CLOCK_DRIFT] = 5.0;
+        sigmas[WHEEL_SCALE] = 0.05;
         let mut p = StateMatrix::from_diagonal(&sigmas.component_mul(&sigmas));
         // Some correlation, as after updates.
         p[(DV, PHI + 1)] = 0.3 * sigmas[DV] * sigmas[PHI + 1];
@@ -436,6 +548,36 @@ mod tests {
                     assert_eq!(a.to_bits(), b.to_bits(), "dt {dt}: entry {i}: {a} vs {b}");
                 }
             }
+        }
+    }
+
+    #[test]
+    fn inert_scale_factors_leave_the_other_states_as_the_full_series_does() {
+        // Scale factors off: the leading-block path gives the full series' numbers to the
+        // bit, and the inert rows stay exactly zero; the wheel's factor alone likewise.
+        let off = ProcessNoise {
+            wheel_scale_noise_per_sqrt_s: 0.0,
+            imu_scale: None,
+            ..noise()
+        };
+        let wheel_only = ProcessNoise {
+            imu_scale: None,
+            ..noise()
+        };
+        for (noise, first_inert) in [(off, WHEEL_SCALE), (wheel_only, GYRO_SCALE)] {
+            let f = system_matrix(&moving_point(), &noise);
+            let q = noise_density(&noise);
+            let mut p0 = prior();
+            for i in first_inert..N {
+                p0.row_mut(i).fill(0.0);
+                p0.column_mut(i).fill(0.0);
+            }
+            let fast = propagate_covariance(&f, &q, &p0, 0.01);
+            let full = series(&f, &q, &p0, 0.01);
+            for (a, b) in fast.iter().zip(full.iter()) {
+                assert_eq!(a.to_bits(), b.to_bits());
+            }
+            assert!((first_inert..N).all(|i| fast.row(i).iter().all(|&v| v == 0.0)));
         }
     }
 

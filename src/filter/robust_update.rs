@@ -43,6 +43,12 @@
 //! states, parts of the attitude and biases) by 1/α at each adaptive epoch, and P
 //! overflowed within 300 s on both bases. With α = 1 the three forms coincide. The plain EKF without a scheme keeps [`ekf::update`] and its
 //! `filter.joseph_form` option.
+//!
+//! Choice (inert states): the EKF, the schemes and the cubature base run on the states that
+//! are not inert ([`active_states`]: the optional scale factors when switched off, whose rows of
+//! P⁻ are zero); an inert state keeps a zero correction and zero rows of P⁺. The cubature
+//! rule needs a positive-definite P⁻, and with the inert states left out the update is,
+//! to the bit, the one of the state without them.
 
 use nalgebra::{DMatrix, DVector};
 
@@ -54,7 +60,7 @@ use crate::adaptive::mahalanobis::{chi_square_quantile, mahalanobis_squared};
 use crate::adaptive::predicted_residual::{predicted_residual_statistic, standardized_residuals};
 use crate::filter::cubature::{cubature_measurement_update, Gaussian};
 use crate::filter::ekf::{self, FilterError};
-use crate::ins::error_state::{StateMatrix, StateVector, N};
+use crate::ins::error_state::{active_states, StateMatrix, StateVector, N};
 use crate::linalg::{symmetrize, SpdFactor, EIGEN_FLOOR};
 
 /// The predicted measurements of the nominal state, alone and corrected by an error δx:
@@ -176,11 +182,20 @@ impl RobustUpdate {
         if !self.cubature && self.scheme == Scheme::Plain {
             return self.plain_ekf(p, set);
         }
-        let mut prior = DMatrix::from_column_slice(N, N, p.as_slice());
+        let sub = Subspace(active_states(p));
+        let n = sub.0.len();
+        let reduced = MeasurementSet {
+            h: sub.columns(&set.h),
+            y: set.y.clone(),
+            r: set.r.clone(),
+            model: set.model,
+        };
+        let set = &reduced;
+        let mut prior = sub.matrix(p);
         if self.cubature {
             prior = covariance_for_cubature(&prior)?;
         }
-        let nominal = self.moments(&prior, set, &set.r)?;
+        let nominal = self.moments(&prior, set, &set.r, &sub)?;
         let hph = symmetrize(&(&nominal.s - &set.r));
         let (prior_nis, prior_log_det_s) = normalized_squared(&nominal.innovation, &nominal.s);
         let mut outcome = UpdateOutcome {
@@ -234,7 +249,7 @@ impl RobustUpdate {
             // and R̄ = D R D is a congruence of R; both are symmetrised before use.
             let inflated = symmetrize(&prior) / alpha;
             let r_used = r_bar.unwrap_or_else(|| set.r.clone());
-            self.moments(&inflated, set, &r_used)?
+            self.moments(&inflated, set, &r_used, &sub)?
         };
         let factor = SpdFactor::new("innovation covariance", &moments.s)?;
         let gain = factor.solve(&moments.pxz.transpose()).transpose();
@@ -242,7 +257,7 @@ impl RobustUpdate {
         // Joseph's form with the measurements' noise R̄ (not the paper's αR̄, see the
         // module's "Choice (posterior)"): the covariance of the estimate of the gain K̄
         // from the prior P⁻, never below the optimal posterior of P⁻ and R̄.
-        let a = DMatrix::identity(N, N) - &gain * &set.h;
+        let a = DMatrix::identity(n, n) - &gain * &set.h;
         let r_used = r_bar_used.unwrap_or_else(|| set.r.clone());
         let posterior = symmetrize(
             &(&a * &prior * a.transpose() + &gain * symmetrize(&r_used) * gain.transpose()),
@@ -250,8 +265,8 @@ impl RobustUpdate {
         let nis = moments
             .innovation
             .dot(&factor.solve_vector(&moments.innovation));
-        let dx = StateVector::from_column_slice(dx.as_slice());
-        let posterior = StateMatrix::from_column_slice(posterior.as_slice());
+        let dx = sub.full_vector(&dx);
+        let posterior = sub.full_matrix(&posterior);
         if !(dx.iter().all(|v| v.is_finite())
             && posterior.iter().all(|v| v.is_finite())
             && nis.is_finite())
@@ -268,9 +283,17 @@ impl RobustUpdate {
         })
     }
 
-    /// The EKF of [`ekf::update`], unchanged (with its Joseph option).
+    /// The EKF of [`ekf::update`], unchanged (with its Joseph option), on the states that
+    /// are not inert.
     fn plain_ekf(&self, p: &StateMatrix, set: &MeasurementSet) -> Result<Correction, FilterError> {
-        let result = ekf::update(p, &set.h, &set.y, &set.r, self.joseph)?;
+        let sub = Subspace(active_states(p));
+        let result = ekf::update(
+            &sub.matrix(p),
+            &sub.columns(&set.h),
+            &set.y,
+            &set.r,
+            self.joseph,
+        )?;
         let m = set.y.len();
         let (_, prior_log_det_s) = normalized_squared(&set.y, &result.s);
         let outcome = UpdateOutcome {
@@ -287,18 +310,20 @@ impl RobustUpdate {
             robust_weights: DVector::from_element(m, f64::NAN),
         };
         Ok(Correction {
-            dx: result.dx,
-            p: result.p,
+            dx: sub.full_vector(&result.dx),
+            p: sub.full_matrix(&result.p),
             outcome,
         })
     }
 
-    /// Innovation, S and P_xz of the prior covariance `p` and the noise `r`.
+    /// Innovation, S and P_xz of the prior covariance `p` and the noise `r`, on the states
+    /// of `sub`.
     fn moments(
         &self,
         p: &DMatrix<f64>,
         set: &MeasurementSet,
         r: &DMatrix<f64>,
+        sub: &Subspace,
     ) -> Result<Moments, FilterError> {
         if !self.cubature {
             let pxz = p * set.h.transpose();
@@ -315,14 +340,14 @@ impl RobustUpdate {
             return Err(FilterError::NonFinite);
         }
         let g = |e: &DVector<f64>| {
-            let dx = StateVector::from_column_slice(e.as_slice());
+            let dx = sub.full_vector(e);
             match set.model.predict_corrected(&dx) {
                 Some(predicted) if predicted.len() == m => &nominal - predicted,
                 _ => DVector::from_element(m, f64::NAN),
             }
         };
         let prior = Gaussian {
-            mean: DVector::zeros(N),
+            mean: DVector::zeros(sub.0.len()),
             covariance: p.clone(),
         };
         let u = cubature_measurement_update(&prior, &set.y, r, g)?;
@@ -331,6 +356,43 @@ impl RobustUpdate {
             s: u.innovation_covariance,
             pxz: u.cross_covariance,
         })
+    }
+}
+
+/// The states an update runs on, in increasing order, and the maps between them and the
+/// whole error state (the others are zero).
+struct Subspace(Vec<usize>);
+
+impl Subspace {
+    /// The rows and columns of `p` on the subspace.
+    fn matrix(&self, p: &StateMatrix) -> DMatrix<f64> {
+        let n = self.0.len();
+        DMatrix::from_fn(n, n, |i, j| p[(self.0[i], self.0[j])])
+    }
+
+    /// The columns of `h` (m × N) on the subspace.
+    fn columns(&self, h: &DMatrix<f64>) -> DMatrix<f64> {
+        h.select_columns(&self.0)
+    }
+
+    /// A vector of the subspace in the whole state.
+    fn full_vector(&self, v: &DVector<f64>) -> StateVector {
+        let mut full = StateVector::zeros();
+        for (k, &i) in self.0.iter().enumerate() {
+            full[i] = v[k];
+        }
+        full
+    }
+
+    /// A matrix of the subspace in the whole state.
+    fn full_matrix(&self, m: &DMatrix<f64>) -> StateMatrix {
+        let mut full = StateMatrix::zeros();
+        for (a, &i) in self.0.iter().enumerate() {
+            for (b, &j) in self.0.iter().enumerate() {
+                full[(i, j)] = m[(a, b)];
+            }
+        }
+        full
     }
 }
 

@@ -288,9 +288,13 @@ fn velocity_dynamics(state: &FilterState, noise: &ProcessNoise) -> SMatrix<f64, 
     let f_ib_b_m_s2 = state
         .prev_increment
         .map_or(Vector3::zeros(), |i| i.dv_b_m_s / i.dt_s);
+    let w_ib_b_rad_s = state
+        .prev_increment
+        .map_or(Vector3::zeros(), |i| i.dtheta_b_rad / i.dt_s);
     let lin = LinearizationPoint {
         nav: state.nav,
         f_ib_b_m_s2,
+        w_ib_b_rad_s,
     };
     process_model::system_matrix(&lin, noise)
         .fixed_rows::<3>(DV)

@@ -6,12 +6,13 @@
 //! arm from the IMU. With δV = computed − true, C_b^n(true) = exp(φ×) C_b^n(computed) and
 //! the compensated rate ω + δb (δb the bias error the feedback adds to the estimate),
 //! v_p^b(computed) − v_p^b(true) = C_n^b δV − C_n^b [v^n×] φ − [l×] δb, the gyro part on
-//! the constant and the Gauss-Markov block alike.
+//! the constant and the Gauss-Markov block alike, and − [l×] diag(ω) δs_g on the gyro
+//! scale-factor block (whose rate error is diag(ω) δs_g).
 
 use nalgebra::Vector3;
 
 use crate::filter::measurement_rows::Row;
-use crate::ins::error_state::{DV, GYRO_BIAS, GYRO_GM, PHI};
+use crate::ins::error_state::{DV, GYRO_BIAS, GYRO_GM, GYRO_SCALE, PHI};
 
 use super::super::filter_state::FilterState;
 
@@ -31,6 +32,8 @@ pub(super) fn point_velocity_rows(
     let c_nb = state.nav.q_nb.inverse().to_rotation_matrix().into_inner();
     let d_dphi = -(c_nb * state.nav.v_n.cross_matrix());
     let d_db = -lever_arm_b_m.cross_matrix();
+    let w = state.compensate(&state.last_imu).w_ib_b_rad_s;
+    let d_dsg = d_db * nalgebra::Matrix3::from_diagonal(&w);
     axes.iter()
         .map(|&axis| {
             let mut row = Row::zeros();
@@ -41,6 +44,8 @@ pub(super) fn point_velocity_rows(
                 .copy_from(&d_db.row(axis));
             row.fixed_view_mut::<1, 3>(0, GYRO_GM)
                 .copy_from(&d_db.row(axis));
+            row.fixed_view_mut::<1, 3>(0, GYRO_SCALE)
+                .copy_from(&d_dsg.row(axis));
             row
         })
         .collect()
