@@ -68,11 +68,12 @@ pub const MAX_NAMES: usize = 256;
 pub const MAX_VALUE_LEN: usize = 1024;
 /// Largest reply payload (bytes of CDR).
 ///
-/// Choice: 48 KiB. A reply larger than a UDP datagram (about 64 KB) never reaches a
-/// Cyclone DDS client (issue 12), so 16 KiB are left for the RTPS headers; the describe
-/// reply of every parameter takes about half of this budget (25 KB with the IMU screen's
-/// and the IMU frame's parameters; it outgrew 32 KiB's three quarters).
-pub const MAX_REPLY_BYTES: usize = 48 * 1024;
+/// Choice: 56 KiB. A reply larger than a UDP datagram (65,507 bytes of payload) never
+/// reaches a Cyclone DDS client (issue 12), so 8 KiB are left for the RTPS headers (a
+/// few hundred bytes); the describe reply of every parameter takes about two thirds of
+/// this budget (38.6 KB with the scale-factor, dual-antenna and slow-error parameters; it
+/// outgrew 48 KiB's three quarters, as it had 32 KiB's).
+pub const MAX_REPLY_BYTES: usize = 56 * 1024;
 
 /// The parameter services' state: the node-level parameters and the rate limit of the
 /// refusals' log lines.
