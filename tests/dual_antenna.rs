@@ -338,3 +338,27 @@ fn bad_headings_are_counted_and_never_a_jump() {
     assert!(gated > 10, "{gated}");
     assert!(worst_deg < 0.1, "{worst_deg}");
 }
+
+/// Without a pair, parked, with a configured heading 20° off and a σ of 20° (above the
+/// heading bank's threshold): the bank cannot tell the headings apart at rest and starts
+/// at its time limit; its start must stay consistent with the prior it was given (within
+/// its 3σ), and its covariance must cover the error (9-dof NEES within the χ² bound of
+/// 99.73 %, 25.3). With equally weighted hypotheses the noise chose one 72° off.
+#[test]
+fn a_heading_bank_at_rest_stays_with_its_prior() {
+    let mut config = consumer_mems_loose();
+    config.constraints.zupt = true;
+    // The scenario's car faces west (compass 270°).
+    config.init.heading_rad = Some(290f64.to_radians());
+    config.init.heading_sigma_rad = 20f64.to_radians();
+    let errors = run(parked_from_start(), config, Extra::None).errors;
+    let first = errors.first().expect("the bank starts at its time limit");
+    println!(
+        "bank at rest: first solution at t = {:.1} s, heading error {:.1} deg, NEES {:.1}",
+        first.t_s,
+        yaw_error_deg(first),
+        first.nees
+    );
+    assert!(yaw_error_deg(first).abs() < 60.0);
+    assert!(first.nees < 25.3);
+}

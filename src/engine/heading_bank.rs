@@ -88,9 +88,16 @@ impl HeadingBank {
                 let turn = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), i as f64 * spacing);
                 state.nav.q_nb = turn * state.nav.q_nb;
                 state.p[(PHI + 2, PHI + 2)] = (spacing / 2.0).powi(2);
+                // Choice: each hypothesis starts with the log-density of the start's own
+                // heading estimate, N(0, σ²), at its offset, so the bank is the Gaussian
+                // sum of that prior: where the measurements cannot tell the headings apart
+                // (at rest, on a straight road) the start's heading keeps the weight, not
+                // whichever hypothesis the noise favours (with equal weights a car parked
+                // 120 s started 72° off its configured 20° prior).
+                let offset_sigmas = i as f64 * spacing / heading_sigma_rad;
                 Hypothesis {
                     state,
-                    log_likelihood: 0.0,
+                    log_likelihood: -0.5 * offset_sigmas.powi(2),
                     adaptation: Adaptation::new(&bank_config),
                 }
             })
