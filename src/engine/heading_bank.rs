@@ -6,7 +6,8 @@
 //! the heading error times the acceleration), and a single filter converges slowly or to
 //! a wrong, over-confident answer. The bank runs one full filter per hypothesis, the
 //! headings spread over ±3σ (at most the full circle) [`SPACING_RAD`] apart,
-//! each with half the spacing as its heading 1-sigma, where the filter is linear. Every
+//! each with half the spacing as its heading 1-sigma, where the filter is linear, and
+//! each weighted by the start's heading prior at its offset. Every
 //! GNSS measurement updates each hypothesis (plain EKF, no innovation gate, so that every
 //! hypothesis is scored on the same measurements) and adds its log-likelihood
 //! −½(νᵀS⁻¹ν + ln det S). Hypotheses whose likelihood falls below [`PRUNE_RATIO`] of the
