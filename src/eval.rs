@@ -8,6 +8,7 @@ use crate::adaptive::mahalanobis::chi_square_quantile;
 use crate::earth::{self, Llh};
 use crate::engine::Solution;
 use crate::ins::error_state::{DP, DV, N, PHI};
+use crate::ins::mechanization::wrap_pi;
 
 /// One reference sample. Velocity and attitude are optional (a GNSS reference may have
 /// neither).
@@ -86,10 +87,6 @@ pub struct SolutionError {
     pub nees: f64,
     /// Degrees of freedom of `nees`.
     pub nees_dof: usize,
-}
-
-fn wrap_pi(a: f64) -> f64 {
-    (a + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI) - std::f64::consts::PI
 }
 
 /// Errors of `solution` against `truth` (at the same time).

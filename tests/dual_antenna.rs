@@ -160,12 +160,7 @@ fn run(spec: ScenarioSpec, config: Config, extra: Extra) -> Run {
         }
     }
     let counters = session.engine().counters().clone();
-    let errors = session
-        .finish()
-        .errors
-        .into_iter()
-        .map(|(_, e)| e)
-        .collect();
+    let errors = session.finish().into_solution_errors();
     Run {
         errors,
         counters,

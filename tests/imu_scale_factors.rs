@@ -61,12 +61,7 @@ fn drive(config: Config) -> (Vec<SolutionError>, (f64, f64)) {
             at_outage = (state.gyro_scale_error[2], sigma);
         }
     }
-    let errors = session
-        .finish()
-        .errors
-        .into_iter()
-        .map(|(_, e)| e)
-        .collect();
+    let errors = session.finish().into_solution_errors();
     (errors, at_outage)
 }
 

@@ -124,12 +124,7 @@ fn drive(config: Config, wheels: Wheels) -> Drive {
         }
     }
     let counters = session.engine().counters().clone();
-    let errors = session
-        .finish()
-        .errors
-        .into_iter()
-        .map(|(_, e)| e)
-        .collect();
+    let errors = session.finish().into_solution_errors();
     Drive {
         errors,
         counters,

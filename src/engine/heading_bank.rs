@@ -35,6 +35,7 @@ use crate::ins::ImuSample;
 use super::adaptation::Adaptation;
 use super::filter_state::{interpolate, FilterState};
 use super::output::EpochReport;
+use crate::ins::mechanization::wrap_pi;
 
 /// A start whose heading 1-sigma exceeds this runs the bank (rad). Choice: 10°, where the
 /// error-state filter's small-angle linearization starts to fail (sin 20° differs from
@@ -223,8 +224,4 @@ impl HeadingBank {
         state.p[(PHI + 2, PHI + 2)] += spread;
         Some(state)
     }
-}
-
-fn wrap_pi(a: f64) -> f64 {
-    (a + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI) - std::f64::consts::PI
 }

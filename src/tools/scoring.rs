@@ -47,6 +47,11 @@ pub struct SessionReport {
 }
 
 impl SessionReport {
+    /// The errors of the scored solutions, without their environments.
+    pub fn into_solution_errors(self) -> Vec<SolutionError> {
+        self.errors.into_iter().map(|(_, e)| e).collect()
+    }
+
     /// Summary over all scored solutions at or after `from_t_s`.
     pub fn summary(&self, from_t_s: f64) -> ErrorSummary {
         let errors: Vec<SolutionError> = self
