@@ -1,5 +1,8 @@
 //! The adapter's /diagnostics report.
 
+use crate::config::Config;
+use crate::engine::FilterState;
+use crate::ins::error_state::{ACC_SCALE, GYRO_SCALE, WHEEL_SCALE};
 use crate::ros::msg::{DiagnosticArray, DiagnosticStatus, Header, KeyValue, Time};
 
 use super::RosAdapter;
@@ -10,8 +13,9 @@ impl RosAdapter {
     /// changes used and left out by reason, phase and, in `tf_mode`
     /// `map_to_odom` the `odom → base` transforms heard and the Odometry messages without
     /// a `map → odom`, once running, the filter's 3D position sigma (level ERROR when it
-    /// is not finite); level ERROR from a divergence until the filter runs again, WARN
-    /// while initializing or while a second frame sends on `imu`.
+    /// is not finite) and the scale factors it estimates; level ERROR from a divergence
+    /// until the filter runs again, WARN while initializing or while a second frame sends
+    /// on `imu`.
     pub fn diagnostics(&self, node_name: &str, stamp: Time) -> DiagnosticArray {
         let phase = match self.engine.init_phase() {
             Some(p) => format!("initializing ({p:?})"),
@@ -71,6 +75,7 @@ impl RosAdapter {
                 let trace_m2 = state.solution().position_covariance_enu_m2().trace();
                 let sigma_m = position_sigma_3d_m(trace_m2);
                 values.push(key_value("position_sigma_3d_m", format!("{sigma_m:.3}")));
+                values.extend(scale_factor_values(state, self.engine.config()));
                 if !sigma_m.is_finite() {
                     (
                         DiagnosticStatus::ERROR,
@@ -115,6 +120,48 @@ impl RosAdapter {
 fn position_sigma_3d_m(trace_m2: f64) -> f64 {
     if trace_m2 >= 0.0 && trace_m2.is_finite() {
         trace_m2.sqrt()
+    } else {
+        f64::NAN
+    }
+}
+
+/// The scale factors the filter estimates, each with its σ: the wheel odometry's with
+/// `wheel_odometry.scale_factor_state`, the gyro's and accelerometer's errors (ppm, per
+/// body axis) with `imu.scale_factor_states`; none otherwise.
+fn scale_factor_values(state: &FilterState, config: &Config) -> Vec<KeyValue> {
+    let sigma = |i: usize| sigma_of_variance(state.p[(i, i)]);
+    let mut values = Vec::new();
+    if config.wheel_odometry.scale_factor_state {
+        let (factor, factor_sigma) = (state.wheel_scale_factor, sigma(WHEEL_SCALE));
+        values.push(key_value("wheel_scale_factor", format!("{factor:.5}")));
+        values.push(key_value(
+            "wheel_scale_factor_sigma",
+            format!("{factor_sigma:.5}"),
+        ));
+    }
+    if config.imu.scale_factor_states {
+        for (name, error, first) in [
+            ("gyro", state.gyro_scale_error, GYRO_SCALE),
+            ("accel", state.accel_scale_error, ACC_SCALE),
+        ] {
+            let ppm = |x: [f64; 3]| format!("{:.0}, {:.0}, {:.0}", x[0], x[1], x[2]);
+            let errors = error.map(|s| s * 1e6).into();
+            let sigmas = std::array::from_fn(|axis| sigma(first + axis) * 1e6);
+            values.push(key_value(&format!("{name}_scale_error_ppm"), ppm(errors)));
+            values.push(key_value(
+                &format!("{name}_scale_error_sigma_ppm"),
+                ppm(sigmas),
+            ));
+        }
+    }
+    values
+}
+
+/// The σ of a variance: NaN when the variance is NaN or negative (never a σ of zero for a
+/// broken covariance).
+fn sigma_of_variance(variance: f64) -> f64 {
+    if variance >= 0.0 {
+        variance.sqrt()
     } else {
         f64::NAN
     }

@@ -914,6 +914,59 @@ fn wheel_odometry_is_counted_on_diagnostics() {
     assert_eq!(counters.count(RejectionReason::WheelOdometryOff), 0);
 }
 
+/// Issue 14: the scale factors the filter estimates are on /diagnostics with their σ
+/// (within their initial σ once running), and absent when they are not estimated.
+#[test]
+fn estimated_scale_factors_are_on_diagnostics() {
+    let run = |estimated: bool| {
+        let mut config = loose_adapter(OutputFrames::default())
+            .engine()
+            .config()
+            .clone();
+        for key in [
+            "wheel_odometry.enabled",
+            "wheel_odometry.scale_factor_state",
+            "imu.scale_factor_states",
+        ] {
+            config.set_parameter(key, &estimated.to_string()).unwrap();
+        }
+        let mut adapter = RosAdapter::new(config, OutputFrames::default());
+        run_static(&mut adapter, 30.0, |_, _| {});
+        assert_eq!(adapter.engine().init_phase(), None, "running");
+        adapter
+    };
+    let numbers = |adapter: &RosAdapter, key: &str| -> Option<Vec<f64>> {
+        let value = diagnostic(adapter, key)?;
+        Some(value.split(", ").map(|x| x.parse().unwrap()).collect())
+    };
+    let adapter = run(true);
+    let factor = numbers(&adapter, "wheel_scale_factor").unwrap();
+    let factor_sigma = numbers(&adapter, "wheel_scale_factor_sigma").unwrap();
+    assert!((factor[0] - 1.0).abs() < 0.05, "{factor:?}");
+    assert!(
+        factor_sigma[0] > 0.0 && factor_sigma[0] <= 0.05,
+        "{factor_sigma:?}"
+    );
+    for name in ["gyro", "accel"] {
+        let errors = numbers(&adapter, &format!("{name}_scale_error_ppm")).unwrap();
+        let sigmas = numbers(&adapter, &format!("{name}_scale_error_sigma_ppm")).unwrap();
+        assert_eq!((errors.len(), sigmas.len()), (3, 3), "{name}");
+        assert!(errors.iter().all(|e| e.abs() < 3000.0), "{name} {errors:?}");
+        assert!(
+            sigmas.iter().all(|s| *s > 0.0 && *s <= 1000.0),
+            "{name} {sigmas:?}"
+        );
+    }
+    let adapter = run(false);
+    for key in [
+        "wheel_scale_factor",
+        "gyro_scale_error_ppm",
+        "accel_scale_error_ppm",
+    ] {
+        assert_eq!(diagnostic(&adapter, key), None, "{key}");
+    }
+}
+
 /// Issue 14, item 4: a moving-base pair's UBXNavRelPosNED on /diagnostics. The static
 /// scenario's receiver stands facing north with no configured heading: with
 /// `dual_antenna.enabled` and a pair reporting north at each fix, the filter starts (it
