@@ -78,8 +78,8 @@ pub use dual_antenna::{BaselineHeadingReading, CarrierSolution};
 pub use filter_state::{interpolate, FilterState};
 pub use initializer::{InitPhase, Initializer};
 pub use output::{
-    EpochReport, MeasurementKind, Output, PhaseRejection, ResetReason, SatRejection, SatReport,
-    Solution, StatusEvent,
+    EpochReport, FixOutliers, MeasurementKind, Output, PhaseRejection, ResetReason, SatRejection,
+    SatReport, Solution, StatusEvent,
 };
 pub use rejection::{InputRejected, RejectionCounters, RejectionReason};
 pub use retune::{NotRuntimeTunable, RUNTIME_PARAMETERS};
@@ -191,6 +191,7 @@ pub struct Engine {
     monitor: DivergenceMonitor,
     /// Resets after a divergence so far.
     divergence_resets: u64,
+    fix_outliers: FixOutliers,
     /// Time of the last divergence while the filter has not started again since.
     diverged_at_t_s: Option<f64>,
 }
@@ -214,6 +215,7 @@ impl Engine {
             constraints: Constraints::default(),
             monitor: DivergenceMonitor::default(),
             divergence_resets: 0,
+            fix_outliers: FixOutliers::default(),
             diverged_at_t_s: None,
         }
     }
@@ -230,6 +232,11 @@ impl Engine {
     /// The constraint updates applied so far (ZUPT, ZARU, NHC).
     pub fn constraint_updates(&self) -> ConstraintUpdates {
         self.constraints.updates()
+    }
+
+    /// Fix positions and velocities deweighted as outliers so far.
+    pub fn fix_outliers(&self) -> FixOutliers {
+        self.fix_outliers
     }
 
     /// Resets after a divergence from GNSS so far.
@@ -681,6 +688,9 @@ impl Engine {
                         {
                             self.counters
                                 .reject(RejectionReason::BaselineHeadingGated, t);
+                        }
+                        if report {
+                            self.fix_outliers.count(&epoch);
                         }
                         // A wheel speed or a baseline heading is no GNSS input to
                         // monitor, and gives no report (as the motion constraints).

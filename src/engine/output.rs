@@ -235,6 +235,10 @@ pub struct EpochReport {
     /// velocity rows); empty without a robust scheme and in tight coupling, where the
     /// weights are per satellite.
     pub fix_robust_weights: Vec<f64>,
+    /// The position (velocity) of a loosely-coupled fix lay beyond
+    /// `loose.fix_outlier_sigma` and was deweighted.
+    pub fix_position_outlier: bool,
+    pub fix_velocity_outlier: bool,
     /// The report of the epoch's time-differenced carrier-phase update, applied before the
     /// pseudo-ranges (`gnss.tdcp`; None when off or without a previous epoch's phases).
     pub carrier_phase_deltas: Option<Box<EpochReport>>,
@@ -258,8 +262,26 @@ impl EpochReport {
             chi2_threshold: f64::NAN,
             q_scale: 1.0,
             fix_robust_weights: Vec::new(),
+            fix_position_outlier: false,
+            fix_velocity_outlier: false,
             carrier_phase_deltas: None,
         }
+    }
+}
+
+/// The receiver fixes whose position or velocity was deweighted as an outlier
+/// (`loose.fix_outlier_sigma`), so far (shown on /diagnostics).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct FixOutliers {
+    pub position: u64,
+    pub velocity: u64,
+}
+
+impl FixOutliers {
+    /// Counts the outliers of the fix update `report`.
+    pub fn count(&mut self, report: &EpochReport) {
+        self.position += u64::from(report.fix_position_outlier);
+        self.velocity += u64::from(report.fix_velocity_outlier);
     }
 }
 

@@ -7,7 +7,8 @@
 //! fields of the report. The step does what every model shares, in this order:
 //! 1. the variant's noise strategy turns the nominal noise into the R of the update
 //!    (per scalar measurement and channel, or for the whole measurement at once);
-//! 2. the innovation gate (scalar measurements);
+//! 2. the innovation gate (scalar measurements), or the deweighting of a joint
+//!    measurement's outlying blocks;
 //! 3. the update of the variant's base filter and scheme ([`crate::filter::robust_update`])
 //!    and the feedback of its correction;
 //! 4. the report's common fields, and the process-noise scaling learns from the innovation;
@@ -101,7 +102,12 @@ pub fn apply<M: MeasurementModel>(
             channels,
             gate_sigma,
         } => step.scalars(state, &lin, channels, *gate_sigma)?,
-        NominalNoise::Joint(r) => step.joint(state, &lin, r)?,
+        NominalNoise::Joint(r) => step.joint(state, &lin, r, None)?,
+        NominalNoise::JointBlocks {
+            r,
+            block_lengths,
+            outlier_sigma,
+        } => step.joint(state, &lin, r, Some((block_lengths, *outlier_sigma)))?,
     }
     Ok(step.report)
 }
@@ -223,23 +229,33 @@ impl<M: MeasurementModel> Step<'_, M> {
         Ok(())
     }
 
-    /// A measurement whose noise is one matrix: updated as a whole, and the noise strategy
-    /// learns from its post-update residual.
+    /// A measurement whose noise is one matrix: updated as a whole (its outlying blocks
+    /// deweighted when `outliers`, their lengths and σ, are given), and the noise strategy
+    /// learns from its post-update residual unless a block was an outlier.
     fn joint(
         &mut self,
         state: &mut FilterState,
         lin: &Linearization,
         r_nominal: &DMatrix<f64>,
+        outliers: Option<(&[usize], f64)>,
     ) -> Result<(), FilterError> {
         let kind = self.model.kind();
-        let r = self.adaptation.noise.joint_covariance(kind, r_nominal);
+        let mut r = self.adaptation.noise.joint_covariance(kind, r_nominal);
         self.report.q_scale = self.adaptation.q.scale();
+        let y = innovations(lin);
         let every: Vec<usize> = (0..lin.rows.len()).collect();
-        if every.is_empty() {
+        let (kept, outlying) = match outliers {
+            Some((block_lengths, outlier_sigma)) if outlier_sigma > 0.0 => {
+                self.deweight_outlying_blocks(state, lin, &y, &mut r, block_lengths, outlier_sigma)
+            }
+            _ => (every.clone(), false),
+        };
+        if kept.is_empty() {
             return Ok(());
         }
-        let h = self.correct(state, Rows::select(lin, &innovations(lin), &every), r)?;
-        if self.learn {
+        let r_kept = r.select_rows(&kept).select_columns(&kept);
+        let h = self.correct(state, Rows::select(lin, &y, &kept), r_kept)?;
+        if self.learn && !outlying {
             let measured = DVector::from_column_slice(&lin.measured);
             let residual = -(self.model.predict(state, &every) - measured);
             let p = DMatrix::from_column_slice(N, N, state.p.as_slice());
@@ -255,6 +271,60 @@ impl<M: MeasurementModel> Step<'_, M> {
             );
         }
         Ok(())
+    }
+
+    /// Bounds the pull of each block of `block_lengths` (consecutive rows from row 0)
+    /// whose Mahalanobis distance d under S = H P Hᵀ + R exceeds `outlier_sigma` (c): its
+    /// rows and columns of `r` are scaled by d / c, its covariance by (d / c)², and the
+    /// model is told. Returns the rows to update with (all but a block whose S is not
+    /// positive definite) and whether any block was an outlier.
+    ///
+    /// Choice: inflation, not rejection. A receiver's claimed covariance is often a few
+    /// times too small where its fixes are degraded (foliage: errors of 2–12 m at a
+    /// claimed 0.7 m); rejecting beyond 5σ there leaves the filter free-inertial for
+    /// minutes (a consumer-MEMS drive ran off by thousands of kilometres), while an
+    /// inflated fix still pulls, as one whose innovation lies about on the gate would
+    /// (with H P Hᵀ ≪ R, yᵀS⁻¹y ≈ c² after scaling); a gross outlier (a street canyon's
+    /// fix 350 m off) pulls by little; in the spirit of the IARF scheme's robust R̄.
+    fn deweight_outlying_blocks(
+        &mut self,
+        state: &FilterState,
+        lin: &Linearization,
+        y: &[f64],
+        r: &mut DMatrix<f64>,
+        block_lengths: &[usize],
+        outlier_sigma: f64,
+    ) -> (Vec<usize>, bool) {
+        let p = DMatrix::from_column_slice(N, N, state.p.as_slice());
+        let mut kept = Vec::with_capacity(lin.rows.len());
+        let mut outlying = false;
+        let mut start = 0;
+        for (block, &len) in block_lengths.iter().enumerate() {
+            let indices: Vec<usize> = (start..start + len).collect();
+            start += len;
+            let rows = Rows::select(lin, y, &indices);
+            let s = &rows.h * &p * rows.h.transpose()
+                + r.select_rows(&indices).select_columns(&indices);
+            let Some(chol) = s.cholesky() else {
+                outlying = true;
+                self.model
+                    .report_outlying_block(&mut self.report, block, f64::NAN);
+                continue;
+            };
+            let sigmas = rows.y.dot(&chol.solve(&rows.y)).sqrt();
+            if sigmas > outlier_sigma {
+                outlying = true;
+                let factor = sigmas / outlier_sigma;
+                for &i in &indices {
+                    r.row_mut(i).scale_mut(factor);
+                    r.column_mut(i).scale_mut(factor);
+                }
+                self.model
+                    .report_outlying_block(&mut self.report, block, sigmas);
+            }
+            kept.extend(indices);
+        }
+        (kept, outlying)
     }
 
     /// The update of the variant's base filter and scheme with `rows` and their covariance

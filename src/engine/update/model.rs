@@ -47,6 +47,11 @@ pub trait MeasurementModel {
     ) {
     }
 
+    /// Notes that block `block` of a [`NominalNoise::JointBlocks`] measurement lay at the
+    /// Mahalanobis distance `sigmas` beyond its outlier σ and was deweighted (NaN: its
+    /// covariance was not positive definite, and it was left out).
+    fn report_outlying_block(&self, _report: &mut EpochReport, _block: usize, _sigmas: f64) {}
+
     /// Notes the update of `rows`, in the order of `outcome`'s vectors.
     fn report_update(&self, report: &mut EpochReport, rows: &[usize], outcome: &UpdateOutcome);
 }
@@ -75,6 +80,15 @@ pub enum NominalNoise {
     /// row of correlated measurements is not an outlier on its own: the robust schemes
     /// weigh them).
     Joint(DMatrix<f64>),
+    /// As [`NominalNoise::Joint`], in blocks: the rows fall into consecutive blocks of
+    /// the given lengths (a fix's position, then its velocity), and a block whose
+    /// Mahalanobis distance √(yᵀS⁻¹y) under its innovation covariance exceeds
+    /// `outlier_sigma` is deweighted (0 = off; see `Step::deweight_outlying_blocks`).
+    JointBlocks {
+        r: DMatrix<f64>,
+        block_lengths: Vec<usize>,
+        outlier_sigma: f64,
+    },
 }
 
 /// A scalar measurement's channel and nominal variance.

@@ -4,18 +4,18 @@
 
 use nalgebra::{DVector, UnitQuaternion, Vector3};
 
-use crate::config::{Config, FilterVariant};
-use crate::earth::Llh;
+use crate::config::{Config, Coupling, FilterVariant};
+use crate::earth::{self, Llh};
 use crate::filter::robust_update::UpdateOutcome;
-use crate::ins::error_state::{StateMatrix, StateVector, DV, N, PHI};
+use crate::ins::error_state::{StateMatrix, StateVector, DP, DV, N, PHI};
 use crate::ins::{ImuSample, NavState};
 
 use super::super::adaptation::Adaptation;
 use super::super::filter_state::FilterState;
 use super::super::output::{EpochReport, MeasurementKind};
 use super::{
-    apply, BaselineHeading, Linearization, MeasurementModel, NonHolonomic, WheelSpeed, ZeroRate,
-    ZeroVelocity,
+    apply, BaselineHeading, FixMeasurement, GnssFix, Linearization, MeasurementModel, NonHolonomic,
+    WheelSpeed, ZeroRate, ZeroVelocity,
 };
 
 /// The zero-velocity model, reporting the robust weights in the fix's field.
@@ -247,4 +247,44 @@ fn zero_rate_rows_match_differences_but_the_earth_rates_attitude_part() {
             );
         }
     }
+}
+
+/// A fix 300 m above a state that knows its height to 1 m (the configured σ 3 m) is an
+/// outlier (95σ): deweighted, it moves the height by centimetres instead of the 30 m it
+/// moved before `loose.fix_outlier_sigma` (with it off, as the IARF paper's filters), and
+/// is flagged; a fix 2 m off is taken as before.
+#[test]
+fn a_fix_far_beyond_its_covariance_is_deweighted() {
+    let moved_up_m = |offset_up_m: f64, outlier_sigma: f64| {
+        let mut config = Config::default();
+        config.filter.coupling = Coupling::Loose;
+        config.loose.use_fix_covariance = false;
+        config.loose.fix_outlier_sigma = outlier_sigma;
+        let mut adaptation = Adaptation::new(&config);
+        let mut state = moving_state(1e-4);
+        let rad2 = (1.0 / earth::SEMI_MAJOR_AXIS_M).powi(2);
+        for (i, var) in [rad2, rad2, 1.0].into_iter().enumerate() {
+            state.p[(DP + i, DP + i)] = var;
+        }
+        let before_m = state.nav.p.height_m;
+        let mut position = state.nav.p;
+        position.height_m += offset_up_m;
+        let fix = GnssFix {
+            t_s: 0.0,
+            position,
+            position_covariance_enu_m2: None,
+            velocity_enu_mps: None,
+            velocity_covariance_enu_m2_s2: None,
+        };
+        let rate = Vector3::zeros();
+        let mut model = FixMeasurement::new(&fix, &rate, &config, &state);
+        let report = apply(&mut state, &mut model, &mut adaptation, true).unwrap();
+        (state.nav.p.height_m - before_m, report.fix_position_outlier)
+    };
+    let (taken_m, flagged) = moved_up_m(300.0, 0.0);
+    assert!((taken_m - 30.0).abs() < 0.5 && !flagged, "{taken_m}");
+    let (deweighted_m, flagged) = moved_up_m(300.0, 5.0);
+    assert!(deweighted_m.abs() < 0.2 && flagged, "{deweighted_m}");
+    let (near_m, flagged) = moved_up_m(2.0, 5.0);
+    assert_eq!((near_m, flagged), (moved_up_m(2.0, 0.0).0, false));
 }

@@ -8,7 +8,8 @@ use crate::ros::msg::{DiagnosticArray, DiagnosticStatus, Header, KeyValue, Time}
 use super::RosAdapter;
 
 impl RosAdapter {
-    /// The /diagnostics report at `stamp`: input counts, constraint updates by kind,
+    /// The /diagnostics report at `stamp`: input counts, constraint updates by kind, fix
+    /// positions and velocities deweighted as outliers,
     /// rejections by reason, resets after a divergence, with `gnss.tdcp` the phase
     /// changes used and left out by reason, phase and, in `tf_mode`
     /// `map_to_odom` the `odom → base` transforms heard and the Odometry messages without
@@ -34,10 +35,13 @@ impl RosAdapter {
             }
         }
         let updates = self.engine.constraint_updates();
+        let outliers = self.engine.fix_outliers();
         for (key, n) in [
             ("updates_zero_velocity", updates.zero_velocity),
             ("updates_zero_rate", updates.zero_rate),
             ("updates_non_holonomic", updates.non_holonomic),
+            ("fix_position_outliers", outliers.position),
+            ("fix_velocity_outliers", outliers.velocity),
         ] {
             values.push(key_value(key, n.to_string()));
         }
