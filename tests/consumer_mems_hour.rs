@@ -1,0 +1,135 @@
+//! Issue 11's one-hour figure: every variant, loosely and tightly coupled, on the
+//! consumer-MEMS hour (tests/data/consumer_mems_hour.yaml: three GNSS outages of 30–60 s,
+//! foliage, a street canyon whose fixes carry single outliers of 70–360 m, 1 % pseudo-range
+//! outliers over an open street), a car with the IMU noise of its class
+//! (params/imu_consumer_mems.yaml) and `constraints.platform: car`, must stay within the
+//! issue's bounds: 3D RMSE below 2.7 m (KF-GINS's figure on such a drive), the largest 3D
+//! error below 30 m wherever a fix came within the last 30 s, no non-finite solution.
+//!
+//! Before `loose.fix_outlier_sigma` akf_all reached 8.6 m RMSE here (it took the canyon's
+//! outliers nearly whole) and, without the platform's constraint, the divergence monitor
+//! reset ekf, akf_partial and residual_akf six times in the canyon (12 m RMSE); numbers
+//! in docs/results.md ("Consumer-MEMS hour").
+
+use std::path::{Path, PathBuf};
+
+use adaptive_gnss_ins::config::{FilterVariant, VARIANTS};
+use adaptive_gnss_ins::ros::node::params::config_from_files;
+use adaptive_gnss_ins::sim::{Scenario, ScenarioSpec};
+use adaptive_gnss_ins::tools::compare::{compare_bag, NamedConfig};
+use adaptive_gnss_ins::tools::scoring::SessionReport;
+use adaptive_gnss_ins::tools::simulate::{simulate, TRUTH_TOPIC};
+
+/// Seed of the simulation.
+const SEED: u64 = 1;
+/// The issue's bounds.
+const MAX_RMSE_3D_M: f64 = 2.7;
+const MAX_ERROR_3D_M: f64 = 30.0;
+/// How long after the last fix an error still counts against [`MAX_ERROR_3D_M`] (s).
+const FIX_WITHIN_S: f64 = 30.0;
+
+fn repo(path: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(path)
+}
+
+/// The largest 3D error (m) among the solutions with a fix within [`FIX_WITHIN_S`]: an
+/// outage's solutions count from its start for that long (the simulator names the
+/// environment of each solution); NaN when any error is not finite.
+fn largest_error_with_a_fix_m(report: &SessionReport) -> f64 {
+    let mut outage_since_s: Option<f64> = None;
+    let mut largest_m: f64 = 0.0;
+    for (environment, error) in &report.errors {
+        let norm_m = error.position_enu_m.norm();
+        if !norm_m.is_finite() {
+            return f64::NAN;
+        }
+        outage_since_s = match (environment.as_str(), outage_since_s) {
+            ("outage", Some(start_s)) => Some(start_s),
+            ("outage", None) => Some(error.t_s),
+            _ => None,
+        };
+        if outage_since_s.is_none_or(|start_s| error.t_s - start_s <= FIX_WITHIN_S) {
+            largest_m = largest_m.max(norm_m);
+        }
+    }
+    largest_m
+}
+
+/// The hour simulated into a bag in a temporary folder (kept alive by the first).
+fn hour_bag() -> (tempfile::TempDir, PathBuf) {
+    let yaml = std::fs::read_to_string(repo("tests/data/consumer_mems_hour.yaml")).unwrap();
+    let scenario = Scenario::new(ScenarioSpec::from_yaml(&yaml).unwrap(), SEED).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let bag = dir.path().join("hour.mcap");
+    simulate(&scenario, &bag).unwrap();
+    (dir, bag)
+}
+
+/// Runs each of `variants` with `files` and the car's constraint over the hour and asserts
+/// the bounds.
+fn assert_the_hours_bounds(files: &[&str], variants: &[FilterVariant]) {
+    let (_dir, bag) = hour_bag();
+    let files: Vec<PathBuf> = files.iter().map(|f| repo(f)).collect();
+    let mut base = config_from_files(&files).unwrap();
+    base.set_parameter("constraints.platform", "car").unwrap();
+    let configs: Vec<NamedConfig> = variants
+        .iter()
+        .map(|&variant| {
+            let mut config = base.clone();
+            config.filter.variant = variant;
+            NamedConfig {
+                name: variant.as_str().to_owned(),
+                config,
+            }
+        })
+        .collect();
+    for (row, report) in compare_bag(&bag, &configs, TRUTH_TOPIC).unwrap() {
+        let largest_m = largest_error_with_a_fix_m(&report);
+        println!(
+            "{:<13} 3D RMSE {:6.3} m, largest 3D error with a fix within {FIX_WITHIN_S} s {:6.2} m over {} epochs",
+            row.filter,
+            row.pos_rmse_3d_m,
+            largest_m,
+            report.errors.len()
+        );
+        assert!(report.errors.len() > 30_000, "{}", row.filter);
+        assert!(
+            row.pos_rmse_3d_m < MAX_RMSE_3D_M,
+            "{}: 3D RMSE {:.3} m",
+            row.filter,
+            row.pos_rmse_3d_m
+        );
+        assert!(
+            largest_m < MAX_ERROR_3D_M,
+            "{}: largest 3D error {largest_m:.2} m",
+            row.filter
+        );
+    }
+}
+
+#[test]
+fn every_variant_loosely_coupled_meets_the_hours_bounds() {
+    assert_the_hours_bounds(
+        &[
+            "params/ekf.yaml",
+            "params/ekf_loose.yaml",
+            "params/imu_consumer_mems.yaml",
+        ],
+        &[
+            FilterVariant::Ekf,
+            FilterVariant::AkfAll,
+            FilterVariant::AkfPartial,
+            FilterVariant::Iarf,
+            FilterVariant::ResidualAkf,
+        ],
+    );
+}
+
+#[test]
+fn every_variant_tightly_coupled_meets_the_hours_bounds() {
+    let variants: Vec<FilterVariant> = VARIANTS.iter().map(|spec| spec.variant).collect();
+    assert_the_hours_bounds(
+        &["params/ekf.yaml", "params/imu_consumer_mems.yaml"],
+        &variants,
+    );
+}
