@@ -53,14 +53,7 @@ fn every_variant_loosely_coupled_stays_near_the_ekf_on_a_consumer_mems_drive() {
     ];
     let configs: Vec<NamedConfig> = variants
         .iter()
-        .map(|&variant| {
-            let mut config = base.clone();
-            config.filter.variant = variant;
-            NamedConfig {
-                name: variant.as_str().to_owned(),
-                config,
-            }
-        })
+        .map(|&variant| NamedConfig::of_variant(&base, variant))
         .collect();
     let runs = compare_bag(&bag, &configs, TRUTH_TOPIC).unwrap();
     let scored: Vec<(String, f64, f64)> = runs

@@ -74,14 +74,7 @@ fn assert_the_hours_bounds(files: &[&str], variants: &[FilterVariant]) {
     base.set_parameter("constraints.platform", "car").unwrap();
     let configs: Vec<NamedConfig> = variants
         .iter()
-        .map(|&variant| {
-            let mut config = base.clone();
-            config.filter.variant = variant;
-            NamedConfig {
-                name: variant.as_str().to_owned(),
-                config,
-            }
-        })
+        .map(|&variant| NamedConfig::of_variant(&base, variant))
         .collect();
     for (row, report) in compare_bag(&bag, &configs, TRUTH_TOPIC).unwrap() {
         let largest_m = largest_error_with_a_fix_m(&report);

@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use crate::config::Config;
+use crate::config::{Config, FilterVariant};
 use crate::eval::ErrorSummary;
 
 use super::bag_run::BagRunner;
@@ -24,6 +24,18 @@ const SCORE_INTERVAL_S: f64 = 0.0;
 pub struct NamedConfig {
     pub name: String,
     pub config: Config,
+}
+
+impl NamedConfig {
+    /// `base` with `filter.variant` set to `variant`, named after the variant.
+    pub fn of_variant(base: &Config, variant: FilterVariant) -> Self {
+        let mut config = base.clone();
+        config.filter.variant = variant;
+        Self {
+            name: variant.as_str().to_owned(),
+            config,
+        }
+    }
 }
 
 /// Runs every configuration over `bag` (scored against its `truth_topic`) and returns one
