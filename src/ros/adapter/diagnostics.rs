@@ -9,14 +9,13 @@ use super::RosAdapter;
 
 impl RosAdapter {
     /// The /diagnostics report at `stamp`: input counts, constraint updates by kind, fix
-    /// positions and velocities deweighted as outliers,
-    /// rejections by reason, resets after a divergence, with `gnss.tdcp` the phase
-    /// changes used and left out by reason, phase and, in `tf_mode`
-    /// `map_to_odom` the `odom → base` transforms heard and the Odometry messages without
-    /// a `map → odom`, once running, the filter's 3D position sigma (level ERROR when it
-    /// is not finite) and the scale factors it estimates; level ERROR from a divergence
-    /// until the filter runs again, WARN while initializing or while a second frame sends
-    /// on `imu`.
+    /// positions and velocities deweighted as outliers, rejections by reason, resets after
+    /// a divergence, with `gnss.tdcp` the phase changes used and left out by reason, phase
+    /// and, in `tf_mode` `map_to_odom` the `odom → base` transforms heard and the Odometry
+    /// messages without a `map → odom`, once running, the filter's 3D position sigma
+    /// (level ERROR when it is not finite) and the scale factors it estimates; level ERROR
+    /// from a divergence until the filter runs again, WARN while initializing or while a
+    /// second frame sends on `imu`.
     pub fn diagnostics(&self, node_name: &str, stamp: Time) -> DiagnosticArray {
         let phase = match self.engine.init_phase() {
             Some(p) => format!("initializing ({p:?})"),
@@ -77,7 +76,7 @@ impl RosAdapter {
             ),
             (Some(state), _) => {
                 let trace_m2 = state.solution().position_covariance_enu_m2().trace();
-                let sigma_m = position_sigma_3d_m(trace_m2);
+                let sigma_m = sigma_of_variance(trace_m2);
                 values.push(key_value("position_sigma_3d_m", format!("{sigma_m:.3}")));
                 values.extend(scale_factor_values(state, self.engine.config()));
                 if !sigma_m.is_finite() {
@@ -118,12 +117,12 @@ impl RosAdapter {
     }
 }
 
-/// The 3D position sigma the filter claims, from the trace of its ENU position covariance:
-/// NaN when the trace is NaN, infinite or negative, so that a broken covariance reports
-/// ERROR instead of a sigma of zero (`NaN.max(0.0)` is 0).
-fn position_sigma_3d_m(trace_m2: f64) -> f64 {
-    if trace_m2 >= 0.0 && trace_m2.is_finite() {
-        trace_m2.sqrt()
+/// The σ of a variance (the 3D position σ of the trace of the position covariance): NaN
+/// when the variance is NaN, infinite or negative, so that a broken covariance reports
+/// ERROR instead of a σ of zero (`NaN.max(0.0)` is 0).
+fn sigma_of_variance(variance: f64) -> f64 {
+    if variance >= 0.0 && variance.is_finite() {
+        variance.sqrt()
     } else {
         f64::NAN
     }
@@ -161,16 +160,6 @@ fn scale_factor_values(state: &FilterState, config: &Config) -> Vec<KeyValue> {
     values
 }
 
-/// The σ of a variance: NaN when the variance is NaN or negative (never a σ of zero for a
-/// broken covariance).
-fn sigma_of_variance(variance: f64) -> f64 {
-    if variance >= 0.0 {
-        variance.sqrt()
-    } else {
-        f64::NAN
-    }
-}
-
 fn key_value(key: &str, value: String) -> KeyValue {
     KeyValue {
         key: key.to_owned(),
@@ -180,14 +169,14 @@ fn key_value(key: &str, value: String) -> KeyValue {
 
 #[cfg(test)]
 mod tests {
-    use super::position_sigma_3d_m;
+    use super::sigma_of_variance;
 
     #[test]
     fn a_broken_covariance_has_no_sigma() {
-        assert_eq!(position_sigma_3d_m(9.0), 3.0);
-        assert_eq!(position_sigma_3d_m(0.0), 0.0);
-        for trace in [f64::NAN, f64::INFINITY, -1e-6, f64::NEG_INFINITY] {
-            assert!(position_sigma_3d_m(trace).is_nan(), "trace {trace}");
+        assert_eq!(sigma_of_variance(9.0), 3.0);
+        assert_eq!(sigma_of_variance(0.0), 0.0);
+        for variance in [f64::NAN, f64::INFINITY, -1e-6, f64::NEG_INFINITY] {
+            assert!(sigma_of_variance(variance).is_nan(), "variance {variance}");
         }
     }
 }
