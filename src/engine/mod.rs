@@ -111,6 +111,8 @@ pub struct Buffered {
     pub states: usize,
     /// Measurements waiting for the IMU.
     pub measurements: usize,
+    /// IMU samples in the standstill detector's window.
+    pub standstill_samples: usize,
 }
 
 /// A measurement waiting for its time.
@@ -268,12 +270,13 @@ impl Engine {
     }
 
     /// The sizes of the buffers, each bounded ([`MAX_BUFFERED_IMU_SAMPLES`],
-    /// [`MAX_PENDING_MEASUREMENTS`]).
+    /// [`MAX_PENDING_MEASUREMENTS`], [`standstill::MAX_WINDOW_SAMPLES`]).
     pub fn buffered(&self) -> Buffered {
         Buffered {
             imu_samples: self.imu.len(),
             states: self.history.len(),
             measurements: self.pending.len(),
+            standstill_samples: self.standstill.sample_count(),
         }
     }
 
@@ -314,6 +317,7 @@ impl Engine {
         self.history.clear();
         self.pending.clear();
         self.constraints.clear();
+        self.standstill.clear();
         self.last_output_t_s = f64::NEG_INFINITY;
         Output::Status(StatusEvent::Reset { t_s, reason })
     }
@@ -360,7 +364,6 @@ impl Engine {
         if let Some(last) = self.imu.back() {
             if body.t_s - last.t_s > self.config.engine.max_imu_gap_s {
                 self.counters.reject(RejectionReason::ImuGap, body.t_s);
-                self.standstill.clear();
                 out.push(self.reset(body.t_s, ResetReason::ImuGap));
             }
         }

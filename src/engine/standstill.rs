@@ -27,6 +27,10 @@ use crate::ins::ImuSample;
 /// Length of the detector's window (s). Choice: 1 s, many periods of a vehicle's
 /// vibration and short against a start-up.
 pub const WINDOW_S: f64 = 1.0;
+/// Most samples the window holds, whatever their stamps (a flood of samples stamped 1 µs
+/// apart would otherwise fill it). Choice: the engine's IMU buffer's bound, a 1 s window
+/// of a 10 kHz IMU.
+pub const MAX_WINDOW_SAMPLES: usize = super::MAX_BUFFERED_IMU_SAMPLES;
 /// Specific-force spread of a parked vehicle's idle (m/s²). Choice: 10 mg.
 pub const IDLE_ACCEL_M_S2: f64 = 0.098;
 /// Angular-rate spread of a parked vehicle's idle (rad/s). Choice: 0.2 °/s.
@@ -155,16 +159,29 @@ pub struct StandstillDetector {
 }
 
 impl StandstillDetector {
-    /// Adds a body-frame sample (in time order).
+    /// Adds a body-frame sample; one older than the newest (the time went back, as when a
+    /// bag plays in a loop) starts the window again. Before, the window kept the samples
+    /// of the old time line in front and, never older than the new ones by the window's
+    /// length, grew by every sample after a jump back (56 B each: a node fed in a loop
+    /// grew by 1 MiB/s under a 20 kHz IMU).
     pub fn push(&mut self, s: &ImuSample) {
+        if self.samples.back().is_some_and(|newest| s.t_s < newest.t_s) {
+            self.samples.clear();
+        }
         self.samples.push_back(*s);
         while self
             .samples
             .front()
             .is_some_and(|old| old.t_s < s.t_s - WINDOW_S)
+            || self.samples.len() > MAX_WINDOW_SAMPLES
         {
             self.samples.pop_front();
         }
+    }
+
+    /// The samples in the window.
+    pub fn sample_count(&self) -> usize {
+        self.samples.len()
     }
 
     /// Forgets the window (after a gap in the stream).
