@@ -160,10 +160,9 @@ pub struct StandstillDetector {
 
 impl StandstillDetector {
     /// Adds a body-frame sample; one older than the newest (the time went back, as when a
-    /// bag plays in a loop) starts the window again. Before, the window kept the samples
-    /// of the old time line in front and, never older than the new ones by the window's
-    /// length, grew by every sample after a jump back (56 B each: a node fed in a loop
-    /// grew by 1 MiB/s under a 20 kHz IMU).
+    /// bag plays in a loop) starts the window again: the old time line's samples would
+    /// stay in front, never older than the new ones by the window's length, and the
+    /// window would grow by every sample.
     pub fn push(&mut self, s: &ImuSample) {
         if self.samples.back().is_some_and(|newest| s.t_s < newest.t_s) {
             self.samples.clear();
@@ -184,7 +183,7 @@ impl StandstillDetector {
         self.samples.len()
     }
 
-    /// Forgets the window (after a gap in the stream).
+    /// Forgets the window (a filter reset).
     pub fn clear(&mut self) {
         self.samples.clear();
     }
