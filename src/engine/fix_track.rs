@@ -10,8 +10,12 @@
 //!   otherwise set its heading (a 30 m outlier over a 5 s baseline turns the course by
 //!   tens of degrees).
 //! - The line's slope is the velocity at the fixes' weighted mean time; in a turn the
-//!   course has turned on since, by the rate about the vertical times that lag, which the
-//!   caller applies.
+//!   course has turned on since, by the rate about the vertical times that lag, and in an
+//!   acceleration the speed has changed, both of which the caller applies.
+//! - The line's value at the newest fix lags an accelerating platform too: for a constant
+//!   acceleration a it falls short by a·`quadratic_lag_s2` (0.5 m for 0.5 m/s² over five
+//!   fixes a second apart, forty times the σ of an RTK fix), which the caller corrects
+//!   with the acceleration it knows.
 
 use std::collections::VecDeque;
 
@@ -43,6 +47,10 @@ pub struct TrackFit {
     pub cov_v_h_m2_s2: Matrix2<f64>,
     /// `t_s` less the fixes' weighted mean time: how long ago the velocity held (s).
     pub lag_s: f64,
+    /// How far the line's position at `t_s` falls short of a platform accelerating at
+    /// 1 m/s² along its motion (m per m/s², i.e. s²): ½ (0 − L(0)), L the weighted line
+    /// through the squared times (since the newest) of the fixes fitted.
+    pub quadratic_lag_s2: f64,
 }
 
 /// The fixes of the last [`MAX_BASELINE_S`], oldest first.
@@ -105,6 +113,8 @@ struct Line {
     var_a: Vector3<f64>,
     var_b: Vector3<f64>,
     mean_t: f64,
+    /// The weighted line through t² (first axis's weights) at t = 0.
+    t2_line_at_0: f64,
 }
 
 impl Line {
@@ -114,13 +124,16 @@ impl Line {
         let mut var_a = Vector3::zeros();
         let mut var_b = Vector3::zeros();
         let mut mean_t = 0.0;
+        let mut t2_line_at_0 = 0.0;
         for axis in 0..3 {
             let (mut sw, mut swt, mut swtt, mut swx, mut swtx) = (0.0, 0.0, 0.0, 0.0, 0.0);
+            let mut swttt = 0.0;
             for (t, x, sigma) in points {
                 let w = 1.0 / (sigma[axis] * sigma[axis]);
                 sw += w;
                 swt += w * t;
                 swtt += w * t * t;
+                swttt += w * t * t * t;
                 swx += w * x[axis];
                 swtx += w * t * x[axis];
             }
@@ -134,6 +147,7 @@ impl Line {
             var_b[axis] = sw / det;
             if axis == 0 {
                 mean_t = swt / sw;
+                t2_line_at_0 = (swtt * swtt - swt * swttt) / det;
             }
         }
         Some(Self {
@@ -142,6 +156,7 @@ impl Line {
             var_a,
             var_b,
             mean_t,
+            t2_line_at_0,
         })
     }
 
@@ -157,6 +172,7 @@ impl Line {
             v_enu_mps: self.b,
             cov_v_h_m2_s2: Matrix2::new(self.var_b[0], 0.0, 0.0, self.var_b[1]),
             lag_s: -self.mean_t,
+            quadratic_lag_s2: -0.5 * self.t2_line_at_0,
         }
     }
 }
@@ -174,6 +190,31 @@ mod tests {
             velocity_enu_mps: None,
             velocity_covariance_enu_m2_s2: None,
         }
+    }
+
+    #[test]
+    fn the_lags_of_an_accelerating_track_are_known() {
+        // 0.5 m/s² from rest, fixes a second apart: the line's slope is the speed at the
+        // mean time, 2 s back, and its value at the newest fix is a·quadratic_lag short.
+        let config = Config::default();
+        let mut track = FixTrack::default();
+        let a = 0.5;
+        for k in 0..5 {
+            let t = f64::from(k);
+            track.push(&fix(t, 0.5 * a * t * t));
+        }
+        let fit = track.fit(&config).unwrap();
+        assert!((fit.lag_s - 2.0).abs() < 1e-9);
+        assert!(
+            (fit.v_enu_mps[0] - a * (4.0 - fit.lag_s)).abs() < 1e-9,
+            "{fit:?}"
+        );
+        let short_m = earth::llh_to_enu(&fit.position, &fix(4.0, 0.5 * a * 16.0).position)[0];
+        assert!((fit.quadratic_lag_s2 - 1.0).abs() < 1e-9, "{fit:?}");
+        assert!(
+            (short_m + a * fit.quadratic_lag_s2).abs() < 1e-6,
+            "{short_m}"
+        );
     }
 
     #[test]

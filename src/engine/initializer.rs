@@ -71,6 +71,17 @@ const REST_SPEED_MAX_MPS: f64 = 0.5;
 /// consecutive passes (loosely coupled) practically never.
 const MOTION_CONFIDENCE: f64 = 0.999;
 
+/// The horizontal specific force along the body's forward axis (m/s²) of the `recent`
+/// samples' mean, resolved with the attitude `q_nb` (levelled; its yaw does not matter):
+/// the forward acceleration, Coriolis and transport rate (about 1e-4 m/s²) aside.
+fn forward_acceleration_m_s2(q_nb: &UnitQuaternion<f64>, recent: &MotionStatistics) -> f64 {
+    let f_h = (q_nb * recent.mean_f()).xy();
+    (q_nb * Vector3::x())
+        .xy()
+        .try_normalize(1e-9)
+        .map_or(0.0, |forward| f_h.dot(&forward))
+}
+
 /// True when the horizontal vector `x` of covariance `cov` differs from zero beyond the
 /// chi-square quantile (two degrees of freedom: −2 ln(1 − p)) of [`MOTION_CONFIDENCE`].
 fn significant(x: &Vector2<f64>, cov: &Matrix2<f64>) -> bool {
@@ -117,6 +128,9 @@ struct GnssVelocity {
     t_s: f64,
     v_enu_mps: Vector3<f64>,
     cov_h_m2_s2: Matrix2<f64>,
+    /// 1-sigma of what the velocity's extrapolation to `t_s` may have missed (m/s): 0 for
+    /// a receiver's velocity; for the fixes' line, see [`Initializer::track_velocity`].
+    extrapolation_sigma_mps: f64,
     /// False for a displacement of fixes not yet significant for [`MOTION_EPOCHS`].
     confirmed: bool,
 }
@@ -361,6 +375,7 @@ impl Initializer {
                 t_s: epoch.t_s,
                 v_enu_mps: v.vel_enu_mps,
                 cov_h_m2_s2: cov.fixed_view::<2, 2>(0, 0).into(),
+                extrapolation_sigma_mps: 0.0,
                 confirmed: true,
             });
         }
@@ -421,6 +436,7 @@ impl Initializer {
                     t_s: fix.t_s,
                     v_enu_mps: v,
                     cov_h_m2_s2: cov.fixed_view::<2, 2>(0, 0).into(),
+                    extrapolation_sigma_mps: 0.0,
                     confirmed: true,
                 };
                 (Some(velocity), fix.position, fix_var)
@@ -459,10 +475,20 @@ impl Initializer {
         Some(init)
     }
 
-    /// The velocity of the line through the recent fixes ([`FixTrack`]), turned on by the
-    /// rate about the vertical over its lag (a turn's course has moved on), and the line's
-    /// position and its variance at the newest fix; confirmed once the velocity has been
-    /// significant for [`MOTION_EPOCHS`] consecutive fixes.
+    /// The velocity of the line through the recent fixes ([`FixTrack`]) carried over its
+    /// lag to the newest fix, and the line's position there, carried forward likewise, and
+    /// its variance; confirmed once the velocity has been significant for [`MOTION_EPOCHS`]
+    /// consecutive fixes.
+    ///
+    /// Over the lag (about half the baseline, 2 s at 1 Hz) a turn's course has moved on by
+    /// the rate about the vertical times the lag, and, once levelled, the speed by the
+    /// forward acceleration times the lag (the horizontal specific force along the body's
+    /// forward axis, which points along the course as the heading from it assumes); without
+    /// the second a car pulling away at 0.5 m/s² started 1 m/s slow and its first fixes
+    /// threw the heading by degrees. Choice: the acceleration is the recent samples' mean
+    /// (the last second), taken to hold over the whole lag; half of each correction is kept
+    /// as its 1-sigma (`extrapolation_sigma_mps`, and in the position's variance) for the
+    /// change it may have missed. Not levelled (a start in motion), nothing is corrected.
     fn track_velocity(
         &mut self,
         fix: &GnssFix,
@@ -482,14 +508,30 @@ impl Initializer {
             .try_normalize(1e-9)
             .unwrap_or_else(Vector3::z);
         let rotation = nalgebra::Rotation2::new(recent.mean_w().dot(&up) * fit.lag_s);
-        let v_h = rotation * v_h;
+        let mut v_h = rotation * v_h;
+        let accel_m_s2 = self
+            .attitude
+            .as_ref()
+            .filter(|_| recent.count() >= 2)
+            .map_or(0.0, |a| forward_acceleration_m_s2(&a.q_nb, recent));
+        let speed_change_mps = accel_m_s2 * fit.lag_s;
+        let shortfall_m = accel_m_s2 * fit.quadratic_lag_s2;
+        let mut position = fit.position;
+        if let Some(course) = v_h.try_normalize(1e-9) {
+            v_h += course * speed_change_mps;
+            let ahead = course * shortfall_m;
+            position = earth::enu_to_llh(&Vector3::new(ahead[0], ahead[1], 0.0), &position)
+                .unwrap_or(position);
+        }
         let velocity = GnssVelocity {
             t_s: fit.t_s,
             v_enu_mps: Vector3::new(v_h[0], v_h[1], fit.v_enu_mps[2]),
             cov_h_m2_s2: rotation.matrix() * fit.cov_v_h_m2_s2 * rotation.matrix().transpose(),
+            extrapolation_sigma_mps: 0.5 * speed_change_mps.abs(),
             confirmed: self.moving_fixes >= MOTION_EPOCHS,
         };
-        Some((velocity, fit.position, fit.position_var_m2))
+        let position_var_m2 = fit.position_var_m2 + (0.5 * shortfall_m).powi(2);
+        Some((velocity, position, position_var_m2))
     }
 
     /// The levelled attitude turned to the heading found, with the configured 1-sigmas; a
@@ -509,10 +551,15 @@ impl Initializer {
                     .max(v.course_sigma_rad().hypot(COURSE_SIGMA_RAD))
             })
         });
+        // The velocity's own uncertainty where it exceeds the configured σ.
+        let velocity_sigma_mps = course.map_or(i.velocity_sigma_mps, |v| {
+            let own_var = 0.5 * v.cov_h_m2_s2.trace() + v.extrapolation_sigma_mps.powi(2);
+            i.velocity_sigma_mps.max(own_var.max(0.0).sqrt())
+        });
         Alignment {
             q_nb,
             sigma_rad: [i.attitude_sigma_rad, i.attitude_sigma_rad, heading_sigma],
-            velocity_sigma_mps: i.velocity_sigma_mps,
+            velocity_sigma_mps,
         }
     }
 

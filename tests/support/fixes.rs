@@ -30,6 +30,12 @@ impl FixNoise {
         white_sigma_m: [0.55, 1.0],
     };
 
+    /// An RTK receiver with its ambiguities fixed: 1 cm horizontally, 2 cm vertically.
+    pub const RTK: Self = Self {
+        gm_sigma_m: [0.005, 0.01],
+        white_sigma_m: [0.01, 0.02],
+    };
+
     fn total(&self, i: usize) -> f64 {
         self.gm_sigma_m[i].hypot(self.white_sigma_m[i])
     }
