@@ -3,14 +3,16 @@
 //!
 //! `GNSS_INS_SOAK_S=86400 cargo test --release --test node_soak -- --ignored --nocapture`
 //!
-//! A ros2-client peer streams a simulated static receiver in real time, 1 kHz IMU and
-//! 10 Hz GNSS, generated for the whole run (stamps run forward, the satellites move on),
-//! and once a minute one bad message of each kind. The node's resident memory is read
-//! every 30 s and its /diagnostics followed. Asserted at the end: after the first two
-//! minutes memory stays within 5 % of its value then; no reset of any kind (a single
-//! outlying stamp is dropped, not a reset: src/ros/adapter/time_line.rs); each bad
-//! message counted where the node says it drops it; the node alive and still publishing
-//! finite Odometry.
+//! A ros2-client peer streams a simulated static receiver, 1 kHz IMU and 10 Hz GNSS, and
+//! once a minute of stream time one bad message of each kind. The stream runs forward
+//! (stamps and satellites move on) or, with `GNSS_INS_SOAK_LOOP_S`, repeats its first
+//! that many seconds as `ros2 bag play --loop` does (each pass a time jump back, which
+//! resets the filter); `GNSS_INS_SOAK_RATE` plays it faster than real time. The node's
+//! resident memory is read every 30 s and its /diagnostics followed. Asserted at the
+//! end: after the first two minutes memory stays within 5 % of its value then; no reset
+//! but one per loop restart (a single outlying stamp is dropped, not a reset:
+//! src/ros/adapter/time_line.rs); each bad message counted where the node says it drops
+//! it; the node alive and still publishing finite Odometry.
 //!
 //! DDS traffic stays on this machine: the test re-executes itself inside a private
 //! network namespace that has only loopback (tests/netns_support).
@@ -31,9 +33,13 @@ use ros2_client::Name;
 use static_node_support::{diagnostic_count, start_node, type_name, Peer};
 
 const DOMAIN_ID: u16 = 37;
-/// Length of the soak (s), default 10 minutes.
+/// Length of the soak in stream time (s), default 10 minutes.
 const DURATION_ENV: &str = "GNSS_INS_SOAK_S";
 const DEFAULT_DURATION_S: u64 = 600;
+/// Length of one pass of a looped stream (s, a whole number of minutes); unset: forward.
+const LOOP_ENV: &str = "GNSS_INS_SOAK_LOOP_S";
+/// Stream seconds per second of wall time, default 1.
+const RATE_ENV: &str = "GNSS_INS_SOAK_RATE";
 /// Memory is judged against its value this long after the start (buffers grown,
 /// DDS discovery done).
 const SETTLE: Duration = Duration::from_secs(120);
@@ -124,20 +130,35 @@ fn bad_imu(s: &ImuSample) -> [Imu; 5] {
     ]
 }
 
+/// The variable `name` parsed, or `default` when it is unset.
+fn env_or<T: std::str::FromStr>(name: &str, default: T) -> T {
+    std::env::var(name).map_or(default, |v| {
+        v.parse()
+            .unwrap_or_else(|_| panic!("{name}: cannot parse {v:?}"))
+    })
+}
+
 #[test]
 #[ignore = "a soak run by hand (GNSS_INS_SOAK_S seconds, default 600)"]
 fn node_memory_is_flat_and_bad_messages_cause_no_reset() {
     if reexec_in_private_netns("node_memory_is_flat_and_bad_messages_cause_no_reset") {
         return;
     }
-    let duration_s: u64 = std::env::var(DURATION_ENV)
-        .map(|v| v.parse().expect("GNSS_INS_SOAK_S: whole seconds"))
-        .unwrap_or(DEFAULT_DURATION_S);
+    let duration_s: u64 = env_or(DURATION_ENV, DEFAULT_DURATION_S);
+    let loop_s: Option<u64> = std::env::var(LOOP_ENV).ok().map(|_| env_or(LOOP_ENV, 0));
+    let rate: f64 = env_or(RATE_ENV, 1.0);
     assert!(
-        duration_s >= 180,
-        "the soak needs 3 minutes at least (memory settles for 2)"
+        duration_s as f64 / rate >= 180.0,
+        "the soak needs 3 minutes of wall time at least (memory settles for 2)"
     );
-    let scenario = soak_scenario(duration_s as f64);
+    assert!(
+        loop_s.is_none_or(|s| s >= 120 && s % 60 == 0),
+        "{LOOP_ENV}: whole minutes, at least 2 (the bad messages come at second 30 of each)"
+    );
+    assert!(rate > 0.0 && rate <= 20.0, "{RATE_ENV} in (0, 20]");
+    // A pass: the whole stream, or the loop's length.
+    let pass_s = loop_s.unwrap_or(duration_s) as f64;
+    let scenario = soak_scenario(pass_s);
     // With /tf (Peer::matched waits for it), as a robot would run it.
     let node = start_node(
         DOMAIN_ID,
@@ -167,73 +188,90 @@ fn node_memory_is_flat_and_bad_messages_cause_no_reset() {
     let mut next_bad_s = BAD_AT_S;
     let mut gnss_bad_pending = false;
     let mut next_drain = Duration::ZERO;
-    for event in scenario.events() {
-        let event = event.unwrap();
-        let t_s = event.t_s();
-        if t_s > duration_s as f64 {
-            break;
-        }
-        if let Some(wait) = Duration::from_secs_f64(t_s).checked_sub(started.elapsed()) {
-            std::thread::sleep(wait);
-        }
-        match event {
-            SimEvent::Imu(s) => {
-                imu_sent += 1;
-                peer.imu
-                    .publish(outbound::imu(&s, stamp(t_s), "imu_link"))
-                    .unwrap();
-                if t_s >= next_bad_s {
-                    for bad in bad_imu(&s) {
-                        peer.imu.publish(bad).unwrap();
+    let mut last_t_s = 0.0;
+    // Passes begun: a loop restart is a time jump back.
+    let mut passes = 0u64;
+    'stream: for pass in 0u64.. {
+        let pass_start_s = pass as f64 * pass_s;
+        for event in scenario.events() {
+            let event = event.unwrap();
+            let t_s = event.t_s();
+            // A looped pass ends before its last instant, which is the next pass's first.
+            if t_s > pass_s || (loop_s.is_some() && t_s >= pass_s) {
+                break;
+            }
+            let stream_s = pass_start_s + t_s;
+            // A looped stream ends before its last instant too: at a whole number of
+            // passes that instant would begin a pass of one sample, no time jump.
+            if stream_s > duration_s as f64 || (loop_s.is_some() && stream_s >= duration_s as f64) {
+                break 'stream;
+            }
+            passes = pass + 1;
+            last_t_s = t_s;
+            if let Some(wait) =
+                Duration::from_secs_f64(stream_s / rate).checked_sub(started.elapsed())
+            {
+                std::thread::sleep(wait);
+            }
+            match event {
+                SimEvent::Imu(s) => {
+                    imu_sent += 1;
+                    peer.imu
+                        .publish(outbound::imu(&s, stamp(t_s), "imu_link"))
+                        .unwrap();
+                    if stream_s >= next_bad_s {
+                        for bad in bad_imu(&s) {
+                            peer.imu.publish(bad).unwrap();
+                        }
+                        garbage.publish(Garbage { bytes: [0xff; 2] }).unwrap();
+                        rounds += 1;
+                        gnss_bad_pending = true;
+                        next_bad_s += BAD_PERIOD_S;
                     }
-                    garbage.publish(Garbage { bytes: [0xff; 2] }).unwrap();
-                    rounds += 1;
-                    gnss_bad_pending = true;
-                    next_bad_s += BAD_PERIOD_S;
                 }
-            }
-            SimEvent::Gnss { epoch, .. } => {
-                gnss_sent += 1;
-                let good = outbound::gnss_measurements(&epoch, 0, stamp(t_s), "gnss");
-                if gnss_bad_pending {
-                    // This epoch arrives corrupted (one pseudo-range NaN), then a copy of
-                    // it stamped 1000 s ahead.
-                    let mut nan = good.clone();
-                    nan.satellites[0].pseudorange_m = f64::NAN;
-                    peer.gnss.publish(nan).unwrap();
-                    let mut ahead = good;
-                    ahead.header.stamp = stamp(t_s + 1000.0);
-                    peer.gnss.publish(ahead).unwrap();
-                    gnss_bad_pending = false;
-                } else {
-                    peer.gnss.publish(good).unwrap();
+                SimEvent::Gnss { epoch, .. } => {
+                    gnss_sent += 1;
+                    let good = outbound::gnss_measurements(&epoch, 0, stamp(t_s), "gnss");
+                    if gnss_bad_pending {
+                        // This epoch arrives corrupted (one pseudo-range NaN), then a copy of
+                        // it stamped 1000 s ahead.
+                        let mut nan = good.clone();
+                        nan.satellites[0].pseudorange_m = f64::NAN;
+                        peer.gnss.publish(nan).unwrap();
+                        let mut ahead = good;
+                        ahead.header.stamp = stamp(t_s + 1000.0);
+                        peer.gnss.publish(ahead).unwrap();
+                        gnss_bad_pending = false;
+                    } else {
+                        peer.gnss.publish(good).unwrap();
+                    }
                 }
+                _ => {}
             }
-            _ => {}
-        }
-        let elapsed = started.elapsed();
-        if elapsed >= next_drain {
-            heard.drain(&peer);
-            next_drain = elapsed + Duration::from_millis(500);
-        }
-        if elapsed >= RSS_PERIOD * (rss_samples.len() as u32 + 1) {
-            let kb = rss_kb(pid);
-            let d = heard.diagnostics.as_ref();
-            let count = |key| d.and_then(|d| diagnostic_count(d, key));
-            eprintln!(
-                "t = {:>5.0} s  RSS {kb} kB  Odometry {} in the last {} s  \
-                 resets {:?}",
-                elapsed.as_secs_f64(),
-                heard.odometry_since_sample,
-                RSS_PERIOD.as_secs(),
-                RESET_KEYS.map(count)
-            );
-            assert!(
-                heard.odometry_since_sample > 0,
-                "no Odometry in the last {RSS_PERIOD:?}"
-            );
-            heard.odometry_since_sample = 0;
-            rss_samples.push((elapsed, kb));
+            let elapsed = started.elapsed();
+            if elapsed >= next_drain {
+                heard.drain(&peer);
+                next_drain = elapsed + Duration::from_millis(500);
+            }
+            if elapsed >= RSS_PERIOD * (rss_samples.len() as u32 + 1) {
+                let kb = rss_kb(pid);
+                let d = heard.diagnostics.as_ref();
+                let count = |key| d.and_then(|d| diagnostic_count(d, key));
+                eprintln!(
+                    "t = {:>5.0} s  RSS {kb} kB  Odometry {} in the last {} s  \
+                     resets {:?}",
+                    elapsed.as_secs_f64(),
+                    heard.odometry_since_sample,
+                    RSS_PERIOD.as_secs(),
+                    RESET_KEYS.map(count)
+                );
+                assert!(
+                    heard.odometry_since_sample > 0,
+                    "no Odometry in the last {RSS_PERIOD:?}"
+                );
+                heard.odometry_since_sample = 0;
+                rss_samples.push((elapsed, kb));
+            }
         }
     }
     let streamed = started.elapsed();
@@ -251,8 +289,9 @@ fn node_memory_is_flat_and_bad_messages_cause_no_reset() {
     } = heard;
     let diagnostics = diagnostics.expect("no /diagnostics received");
     eprintln!(
-        "streamed {imu_sent} IMU samples and {gnss_sent} GNSS epochs in {:.0} s, {rounds} rounds \
-         of bad messages; {odometry} Odometry received, the last at {last_odometry_s:.3} s",
+        "streamed {imu_sent} IMU samples and {gnss_sent} GNSS epochs in {:.0} s ({passes} \
+         passes), {rounds} rounds of bad messages; {odometry} Odometry received, the last \
+         at {last_odometry_s:.3} s",
         streamed.as_secs_f64()
     );
     eprintln!("diagnostics: {:?}", diagnostics.status[0].values);
@@ -281,14 +320,20 @@ fn node_memory_is_flat_and_bad_messages_cause_no_reset() {
     assert!(node.0.try_wait().unwrap().is_none(), "the node exited");
     assert_eq!(non_finite, 0, "non-finite Odometry published");
     assert!(
-        last_odometry_s > duration_s as f64 - 2.0,
-        "the last Odometry is at {last_odometry_s} s of {duration_s} s"
+        last_odometry_s > last_t_s - 2.0,
+        "the last Odometry is at {last_odometry_s} s, the last sample at {last_t_s} s"
     );
     let count = |key: &str| {
         diagnostic_count(&diagnostics, key).unwrap_or_else(|| panic!("no `{key}` on /diagnostics"))
     };
+    // Each loop restart is a time jump back, followed by a reset; nothing else resets.
     for key in RESET_KEYS {
-        assert_eq!(count(key), 0, "{key}");
+        let expected = if key == "time_jump_resets" {
+            passes - 1
+        } else {
+            0
+        };
+        assert_eq!(count(key), expected, "{key}");
     }
     assert_eq!(
         static_node_support::diagnostic_value(&diagnostics, "phase").as_deref(),
