@@ -191,7 +191,8 @@ fn node_memory_is_flat_and_bad_messages_cause_no_reset() {
     let mut last_t_s = 0.0;
     // Passes begun: a loop restart is a time jump back.
     let mut passes = 0u64;
-    'stream: for pass in 0u64.. {
+    let pass_count = loop_s.map_or(1, |loop_s| duration_s.div_ceil(loop_s));
+    'stream: for pass in 0..pass_count {
         let pass_start_s = pass as f64 * pass_s;
         for event in scenario.events() {
             let event = event.unwrap();
@@ -201,9 +202,7 @@ fn node_memory_is_flat_and_bad_messages_cause_no_reset() {
                 break;
             }
             let stream_s = pass_start_s + t_s;
-            // A looped stream ends before its last instant too: at a whole number of
-            // passes that instant would begin a pass of one sample, no time jump.
-            if stream_s > duration_s as f64 || (loop_s.is_some() && stream_s >= duration_s as f64) {
+            if stream_s > duration_s as f64 {
                 break 'stream;
             }
             passes = pass + 1;
