@@ -85,8 +85,10 @@ impl FilterState {
         // The nominal Gauss-Markov and clock states follow their expected dynamics.
         self.gyro_markov_rad_s *= (-dt / noise.gyro_markov_time_s).exp();
         self.accel_bias_m_s2 *= (-dt / noise.accel_markov_time_s).exp();
-        self.clock_bias_m += self.clock_drift_mps * dt;
-        self.clock_drift_mps *= (-dt / noise.clock_drift_time_s).exp();
+        if let Some(clock) = noise.clock {
+            self.clock_bias_m += self.clock_drift_mps * dt;
+            self.clock_drift_mps *= (-dt / clock.drift_time_s).exp();
+        }
         if let Some(scale) = noise.imu_scale {
             let decay = (-dt / scale.time_s).exp();
             self.gyro_scale_error *= decay;

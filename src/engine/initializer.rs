@@ -31,7 +31,7 @@
 
 use nalgebra::{Matrix2, Matrix3, UnitQuaternion, Vector2, Vector3};
 
-use crate::config::Config;
+use crate::config::{Config, Coupling};
 use crate::earth::{self, Llh};
 use crate::gnss::spp::{self, SppConfig};
 use crate::gnss::GnssEpoch;
@@ -708,8 +708,11 @@ impl Initializer {
         set3(&mut cov, GYRO_GM, [gm, gm, gm]);
         let ab = config.imu.accel_bias_sigma_m_s2.powi(2);
         set3(&mut cov, ACC_BIAS, [ab, ab, ab]);
-        cov[(CLOCK_BIAS, CLOCK_BIAS)] = i.clock_bias_sigma_m.powi(2);
-        cov[(CLOCK_DRIFT, CLOCK_DRIFT)] = i.clock_drift_sigma_mps.powi(2);
+        // Loosely coupled the clock is inert (`super::process_noise`).
+        if config.filter.coupling == Coupling::Tight {
+            cov[(CLOCK_BIAS, CLOCK_BIAS)] = i.clock_bias_sigma_m.powi(2);
+            cov[(CLOCK_DRIFT, CLOCK_DRIFT)] = i.clock_drift_sigma_mps.powi(2);
+        }
         // The optional scale factors: inert (zero variance) when off.
         if config.wheel_odometry.scale_factor_state {
             cov[(WHEEL_SCALE, WHEEL_SCALE)] = config.wheel_odometry.scale_factor_sigma.powi(2);

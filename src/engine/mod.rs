@@ -61,7 +61,7 @@ mod wheel_odometry;
 use std::collections::VecDeque;
 
 use crate::config::{Config, Coupling};
-use crate::filter::process_model::{ImuScaleNoise, ProcessNoise};
+use crate::filter::process_model::{ClockNoise, ImuScaleNoise, ProcessNoise};
 use crate::gnss::GnssEpoch;
 use crate::ins::ImuSample;
 
@@ -738,9 +738,14 @@ pub fn process_noise(config: &Config) -> ProcessNoise {
         accel_vrw_m_s_per_sqrt_s: config.imu.accel_vrw_m_s_per_sqrt_s,
         accel_bias_sigma_m_s2: config.imu.accel_bias_sigma_m_s2,
         accel_markov_time_s: config.imu.accel_markov_time_s,
-        clock_bias_noise_m_per_sqrt_s: config.clock.bias_noise_m_per_sqrt_s,
-        clock_drift_noise_m_s_per_sqrt_s: config.clock.drift_noise_m_s_per_sqrt_s,
-        clock_drift_time_s: config.clock.drift_time_s,
+        // Choice: loosely coupled, nothing measures the receiver clock, so its states are
+        // inert (as the optional states when off): the covariance propagates on 18
+        // states instead of 20, and the other states' numbers are the same to the bit.
+        clock: (config.filter.coupling == Coupling::Tight).then_some(ClockNoise {
+            bias_noise_m_per_sqrt_s: config.clock.bias_noise_m_per_sqrt_s,
+            drift_noise_m_s_per_sqrt_s: config.clock.drift_noise_m_s_per_sqrt_s,
+            drift_time_s: config.clock.drift_time_s,
+        }),
         wheel_scale_noise_per_sqrt_s: if config.wheel_odometry.scale_factor_state {
             config.wheel_odometry.scale_factor_noise_per_sqrt_s
         } else {

@@ -12,7 +12,7 @@ use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 use crate::earth::{self, Llh};
 use crate::ins::error_state::{
     StateMatrix, StateVector, ACC_BIAS, ACC_SCALE, CLOCK_BIAS, CLOCK_DRIFT, DP, DV, GYRO_BIAS,
-    GYRO_GM, GYRO_SCALE, N, PHI, WHEEL_SCALE,
+    GYRO_GM, GYRO_SCALE, N, N_INS, PHI, WHEEL_SCALE,
 };
 use crate::ins::NavState;
 
@@ -31,17 +31,26 @@ pub struct ProcessNoise {
     pub accel_bias_sigma_m_s2: f64,
     /// Correlation time T_a of ∇ (s).
     pub accel_markov_time_s: f64,
-    /// White noise driving the clock offset c·δt_u (m/√s).
-    pub clock_bias_noise_m_per_sqrt_s: f64,
-    /// White noise driving the clock drift c·δt_ru (m/s/√s).
-    pub clock_drift_noise_m_s_per_sqrt_s: f64,
-    /// Correlation time T_ru of the clock drift (s).
-    pub clock_drift_time_s: f64,
+    /// The receiver clock states, eq. (6); None: inert (loosely coupled, where nothing
+    /// measures the clock).
+    pub clock: Option<ClockNoise>,
     /// White noise driving the wheel odometry scale factor (a random walk, 1/√s); zero
     /// when the state is off.
     pub wheel_scale_noise_per_sqrt_s: f64,
     /// The IMU scale-factor states (`imu.scale_factor_states`); None: inert.
     pub imu_scale: Option<ImuScaleNoise>,
+}
+
+/// The receiver clock model of eq. (6): a random-walk offset driven by a first-order
+/// Gauss-Markov drift.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ClockNoise {
+    /// White noise driving the clock offset c·δt_u (m/√s).
+    pub bias_noise_m_per_sqrt_s: f64,
+    /// White noise driving the clock drift c·δt_ru (m/s/√s).
+    pub drift_noise_m_s_per_sqrt_s: f64,
+    /// Correlation time T_ru of the clock drift (s).
+    pub drift_time_s: f64,
 }
 
 /// First-order Gauss-Markov models of the IMU scale-factor errors (as KF-GINS carries them).
@@ -68,8 +77,11 @@ impl ProcessNoise {
             gyro_markov_sigma_rad_s: self.gyro_markov_sigma_rad_s * k,
             accel_vrw_m_s_per_sqrt_s: self.accel_vrw_m_s_per_sqrt_s * k,
             accel_bias_sigma_m_s2: self.accel_bias_sigma_m_s2 * k,
-            clock_bias_noise_m_per_sqrt_s: self.clock_bias_noise_m_per_sqrt_s * k,
-            clock_drift_noise_m_s_per_sqrt_s: self.clock_drift_noise_m_s_per_sqrt_s * k,
+            clock: self.clock.map(|c| ClockNoise {
+                bias_noise_m_per_sqrt_s: c.bias_noise_m_per_sqrt_s * k,
+                drift_noise_m_s_per_sqrt_s: c.drift_noise_m_s_per_sqrt_s * k,
+                ..c
+            }),
             wheel_scale_noise_per_sqrt_s: self.wheel_scale_noise_per_sqrt_s * k,
             imu_scale: self.imu_scale.map(|s| ImuScaleNoise {
                 gyro_sigma: s.gyro_sigma * k,
@@ -227,8 +239,10 @@ pub fn system_matrix(lin: &LinearizationPoint, noise: &ProcessNoise) -> StateMat
         set(ACC_SCALE, ACC_SCALE, &decay);
     }
     // Eq. (6): receiver clock.
-    f[(CLOCK_BIAS, CLOCK_DRIFT)] = 1.0;
-    f[(CLOCK_DRIFT, CLOCK_DRIFT)] = -1.0 / noise.clock_drift_time_s;
+    if let Some(clock) = noise.clock {
+        f[(CLOCK_BIAS, CLOCK_DRIFT)] = 1.0;
+        f[(CLOCK_DRIFT, CLOCK_DRIFT)] = -1.0 / clock.drift_time_s;
+    }
     f
 }
 
@@ -259,8 +273,10 @@ pub fn noise_density(noise: &ProcessNoise) -> StateVector {
         diag3(GYRO_SCALE, 2.0 * scale.gyro_sigma.powi(2) / scale.time_s);
         diag3(ACC_SCALE, 2.0 * scale.accel_sigma.powi(2) / scale.time_s);
     }
-    q[CLOCK_BIAS] = noise.clock_bias_noise_m_per_sqrt_s.powi(2);
-    q[CLOCK_DRIFT] = noise.clock_drift_noise_m_s_per_sqrt_s.powi(2);
+    if let Some(clock) = noise.clock {
+        q[CLOCK_BIAS] = clock.bias_noise_m_per_sqrt_s.powi(2);
+        q[CLOCK_DRIFT] = clock.drift_noise_m_s_per_sqrt_s.powi(2);
+    }
     q[WHEEL_SCALE] = noise.wheel_scale_noise_per_sqrt_s.powi(2);
     q
 }
@@ -334,11 +350,11 @@ fn lyapunov<const M: usize>(fx: &Rows<M>, i: usize, j: usize) -> f64 {
 /// (radians of latitude, metres of clock) lose nothing to each other. The unit test
 /// checks it against the matrix exponential of Van Loan's block matrix.
 ///
-/// Choice (inert states): when the trailing scale-factor states are inert (zero variance,
-/// rows of F and density: [`crate::ins::error_state`]'s Choice), the series runs
-/// on the leading 20 (or 21, the wheel's factor on) states only and the rest stays zero:
-/// the same numbers to the bit as the series on all N (a unit test compares them), at the
-/// cost of the paper's 20 states instead of 27 (docs/benchmarks.md).
+/// Choice (inert states): when the trailing states are inert (zero variance, rows of F and
+/// density: [`crate::ins::error_state`]'s Choice), the series runs on the leading 18 (the
+/// clock inert too, loosely coupled), 20 or 21 (the wheel's factor on) states only and the
+/// rest stays zero: the same numbers to the bit as the series on all N (a unit test
+/// compares them), at the cost of 18 or 20 states instead of 27 (docs/benchmarks.md).
 pub fn propagate_covariance(
     f: &StateMatrix,
     q_c: &StateVector,
@@ -347,7 +363,9 @@ pub fn propagate_covariance(
 ) -> StateMatrix {
     const PAPER: usize = CLOCK_DRIFT + 1;
     const WITH_WHEEL: usize = WHEEL_SCALE + 1;
-    if inert_from(PAPER, f, q_c, p) {
+    if inert_from(N_INS, f, q_c, p) {
+        on_leading::<N_INS>(f, q_c, p, dt_s)
+    } else if inert_from(PAPER, f, q_c, p) {
         on_leading::<PAPER>(f, q_c, p, dt_s)
     } else if inert_from(WITH_WHEEL, f, q_c, p) {
         on_leading::<WITH_WHEEL>(f, q_c, p, dt_s)
@@ -450,9 +468,11 @@ mod tests {
             accel_vrw_m_s_per_sqrt_s: 100e-6 * 9.80665,
             accel_bias_sigma_m_s2: 1250e-6 * 9.80665,
             accel_markov_time_s: 3600.0,
-            clock_bias_noise_m_per_sqrt_s: 0.5,
-            clock_drift_noise_m_s_per_sqrt_s: 0.1,
-            clock_drift_time_s: 1800.0,
+            clock: Some(ClockNoise {
+                bias_noise_m_per_sqrt_s: 0.5,
+                drift_noise_m_s_per_sqrt_s: 0.1,
+                drift_time_s: 1800.0,
+            }),
             wheel_scale_noise_per_sqrt_s: 1e-5,
             imu_scale: Some(ImuScaleNoise {
                 gyro_sigma: 300e-6,
@@ -552,9 +572,16 @@ mod tests {
     }
 
     #[test]
-    fn inert_scale_factors_leave_the_other_states_as_the_full_series_does() {
+    fn inert_states_leave_the_other_states_as_the_full_series_does() {
         // Scale factors off: the leading-block path gives the full series' numbers to the
-        // bit, and the inert rows stay exactly zero; the wheel's factor alone likewise.
+        // bit, and the inert rows stay exactly zero; the wheel's factor alone likewise, and
+        // the clock off too (loosely coupled).
+        let no_clock = ProcessNoise {
+            clock: None,
+            wheel_scale_noise_per_sqrt_s: 0.0,
+            imu_scale: None,
+            ..noise()
+        };
         let off = ProcessNoise {
             wheel_scale_noise_per_sqrt_s: 0.0,
             imu_scale: None,
@@ -564,7 +591,11 @@ mod tests {
             imu_scale: None,
             ..noise()
         };
-        for (noise, first_inert) in [(off, WHEEL_SCALE), (wheel_only, GYRO_SCALE)] {
+        for (noise, first_inert) in [
+            (no_clock, CLOCK_BIAS),
+            (off, WHEEL_SCALE),
+            (wheel_only, GYRO_SCALE),
+        ] {
             let f = system_matrix(&moving_point(), &noise);
             let q = noise_density(&noise);
             let mut p0 = prior();
