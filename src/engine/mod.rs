@@ -85,15 +85,27 @@ pub use rejection::{InputRejected, RejectionCounters, RejectionReason};
 pub use retune::{NotRuntimeTunable, RUNTIME_PARAMETERS};
 pub use update::GnssFix;
 
-/// Most IMU samples buffered, and filter states stored after them, whatever
-/// `engine.imu_buffer_s` says.
+/// Most IMU samples buffered, and steps kept after them, whatever `engine.imu_buffer_s`
+/// says.
 ///
 /// Choice: 10,000: 10 s of a 1 kHz IMU, the default 2 s of a 5 kHz one. Samples stamped
 /// microseconds apart (a flood, a broken clock) would otherwise fill the time window with
-/// millions of states; with the bound the buffers hold at most some 35 MB (a stored state
-/// is about 3.5 KB, most of it the 20×20 covariance). Where it binds, a late measurement
-/// reaches back less far than `engine.imu_buffer_s` (rejected as too old, counted).
+/// millions of states; with the bound the buffers hold at most some 5 MB (a stored state
+/// is about 6 KB, most of it the covariance, one every [`STATE_EVERY_STEPS`]). Where it
+/// binds, a late measurement reaches back less far than `engine.imu_buffer_s` (rejected
+/// as too old, counted).
 pub const MAX_BUFFERED_IMU_SAMPLES: usize = 10_000;
+
+/// A filter state is kept for roll-backs after every this many IMU steps.
+///
+/// Choice: 10. A roll-back restarts from the last kept state at or before the late
+/// measurement and re-integrates the samples after it, which it does anyway for the
+/// samples after the measurement: keeping one state in ten costs a roll-back at most nine
+/// more samples (a few tens of microseconds), and saves copying a state (about 6 KB) on
+/// every sample, a tenth of the engine's time at 200 Hz. The re-integrated states are the
+/// ones first computed (the same steps on the same samples), except where an adaptive
+/// scheme has learned since, as for the samples after the measurement.
+pub const STATE_EVERY_STEPS: usize = 10;
 
 /// Most measurements waiting for the IMU to pass their time.
 ///
@@ -107,7 +119,9 @@ pub const MAX_PENDING_MEASUREMENTS: usize = 100;
 pub struct Buffered {
     /// IMU samples kept for roll-backs.
     pub imu_samples: usize,
-    /// Filter states stored after them.
+    /// Steps kept after them (the measurements applied in each).
+    pub steps: usize,
+    /// Filter states kept with the steps (one every [`STATE_EVERY_STEPS`]).
     pub states: usize,
     /// Measurements waiting for the IMU.
     pub measurements: usize,
@@ -147,10 +161,13 @@ struct Pending {
     reported: bool,
 }
 
-/// The filter state after one IMU sample, with the measurements applied in that step.
+/// One IMU step while running: the measurements applied in it and, every
+/// [`STATE_EVERY_STEPS`], the filter state after it.
 #[derive(Debug, Clone)]
-struct Snapshot {
-    state: FilterState,
+struct Step {
+    /// Time of the IMU sample the step ended at (s).
+    t_s: f64,
+    state: Option<Box<FilterState>>,
     applied: Vec<Measurement>,
 }
 
@@ -170,8 +187,8 @@ pub struct Engine {
     phase: Phase,
     /// Raw body-frame IMU samples of the last `imu_buffer_s`.
     imu: VecDeque<ImuSample>,
-    /// Filter states after each of the buffered IMU samples (while running).
-    history: VecDeque<Snapshot>,
+    /// The steps to each of the buffered IMU samples (while running).
+    history: VecDeque<Step>,
     pending: Vec<Pending>,
     last_output_t_s: f64,
     counters: RejectionCounters,
@@ -274,7 +291,8 @@ impl Engine {
     pub fn buffered(&self) -> Buffered {
         Buffered {
             imu_samples: self.imu.len(),
-            states: self.history.len(),
+            steps: self.history.len(),
+            states: self.history.iter().filter(|s| s.state.is_some()).count(),
             measurements: self.pending.len(),
             standstill_samples: self.standstill.sample_count(),
         }
@@ -380,13 +398,8 @@ impl Engine {
         if let Some(oldest) = self.imu.front() {
             self.constraints.forget_before(oldest.t_s);
         }
-        // Room for the state after this sample. `drain` drops the snapshots in place,
-        // where `pop_front` would first copy each one (a state is about 6 kB) out.
-        let stale = self
-            .history
-            .iter()
-            .take_while(|s| s.state.last_imu.t_s < horizon)
-            .count();
+        // Room for the step to this sample.
+        let stale = self.history.iter().take_while(|s| s.t_s < horizon).count();
         let over = (self.history.len() + 1).saturating_sub(MAX_BUFFERED_IMU_SAMPLES);
         self.history.drain(..stale.max(over));
         self.advance(&body, &mut out);
@@ -507,19 +520,22 @@ impl Engine {
                 self.replay_from(None, &mut out);
             }
             Phase::Running(_) => {
-                // Roll back to the last state at or before t.
-                let keep = self.history.iter().rposition(|s| s.state.last_imu.t_s <= t);
+                // Roll back to the last kept state at or before t.
+                let keep = self
+                    .history
+                    .iter()
+                    .rposition(|s| s.t_s <= t && s.state.is_some());
                 match keep {
                     Some(k) => {
                         self.enqueue(m, false);
-                        let undone: Vec<Snapshot> = self.history.drain(k + 1..).collect();
-                        for snap in undone {
-                            for a in snap.applied {
+                        let undone: Vec<Step> = self.history.drain(k + 1..).collect();
+                        for step in undone {
+                            for a in step.applied {
                                 self.enqueue(a, true);
                             }
                         }
-                        let start = self.history.back().map(|s| s.state.clone());
-                        self.replay_from(start, &mut out);
+                        let start = self.history.back().and_then(|s| s.state.as_deref());
+                        self.replay_from(start.cloned(), &mut out);
                     }
                     None => {
                         return Err(self.counters.reject(RejectionReason::MeasurementTooOld, t));
@@ -618,9 +634,20 @@ impl Engine {
                         self.counters.reject(RejectionReason::UpdateFailed, s.t_s);
                     }
                 }
-                let state = state.as_ref().clone();
-                self.emit_solution(&state, out);
-                self.history.push_back(Snapshot { state, applied });
+                let t_s = state.last_imu.t_s;
+                if !self.replaying
+                    && output_due(self.config.output.rate_hz, &mut self.last_output_t_s, t_s)
+                {
+                    out.push(Output::Solution(Box::new(state.solution())));
+                }
+                let keep = (self.history.iter().rev())
+                    .take(STATE_EVERY_STEPS - 1)
+                    .all(|s| s.state.is_none());
+                self.history.push_back(Step {
+                    t_s,
+                    state: keep.then(|| state.clone()),
+                    applied,
+                });
             }
         }
     }
@@ -714,19 +741,16 @@ impl Engine {
             }
         }
     }
+}
 
-    fn emit_solution(&mut self, state: &FilterState, out: &mut Vec<Output>) {
-        if self.replaying {
-            return;
-        }
-        let t = state.last_imu.t_s;
-        let rate = self.config.output.rate_hz;
-        if rate > 0.0 && t - self.last_output_t_s < 1.0 / rate - 1e-9 {
-            return;
-        }
-        self.last_output_t_s = t;
-        out.push(Output::Solution(Box::new(state.solution())));
+/// Whether a solution at `t_s` is due at `rate_hz` (0: every IMU sample) after the last one
+/// at `last_output_t_s`, which it then becomes.
+fn output_due(rate_hz: f64, last_output_t_s: &mut f64, t_s: f64) -> bool {
+    if rate_hz > 0.0 && t_s - *last_output_t_s < 1.0 / rate_hz - 1e-9 {
+        return false;
     }
+    *last_output_t_s = t_s;
+    true
 }
 
 /// The process noise of the configuration.

@@ -7,7 +7,7 @@
 //! δV̇ = f^n × φ − (2ω_ie + ω_en) × δV + V × (2δω_ie + δω_en) + δg + C_b^n ∇ (the printed
 //! "−f^n × f^n" of eq. (2) is a typesetting slip for f^n × φ).
 
-use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
+use nalgebra::{Matrix3, SMatrix, Vector3};
 
 use crate::earth::{self, Llh};
 use crate::ins::error_state::{
@@ -284,10 +284,11 @@ pub fn noise_density(noise: &ProcessNoise) -> StateVector {
 /// A square matrix of the leading `M` states.
 type Square<const M: usize> = SMatrix<f64, M, M>;
 
-/// The non-zero pattern of F (about 85 of 400 entries of the paper's 20 states), row by
-/// row, for cheap products with dense matrices; nothing is allocated per IMU sample.
+/// The non-zero pattern of the leading M × M block of F (about 85 of 400 entries of the
+/// paper's 20 states), row by row, for cheap products with dense matrices; nothing is
+/// copied or allocated per IMU sample.
 struct SparseF<'a, const M: usize> {
-    f: &'a Square<M>,
+    f: &'a StateMatrix,
     /// Bit k of `rows[r]` is set when F[r, k] is not zero (M ≤ N = 27 bits fit a u32).
     rows: [u32; M],
 }
@@ -296,7 +297,7 @@ struct SparseF<'a, const M: usize> {
 type Rows<const M: usize> = [[f64; M]; M];
 
 impl<'a, const M: usize> SparseF<'a, M> {
-    fn new(f: &'a Square<M>) -> Self {
+    fn new(f: &'a StateMatrix) -> Self {
         let rows = std::array::from_fn(|r| {
             (0..M).fold(0u32, |mask, k| mask | (u32::from(f[(r, k)] != 0.0) << k))
         });
@@ -319,7 +320,7 @@ impl<'a, const M: usize> SparseF<'a, M> {
             while mask != 0 {
                 let k = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
-                let v = f[r + M * k];
+                let v = f[r + N * k];
                 for (a, xc) in acc.iter_mut().zip(&x[k * M..(k + 1) * M]) {
                     *a += v * xc;
                 }
@@ -364,13 +365,13 @@ pub fn propagate_covariance(
     const PAPER: usize = CLOCK_DRIFT + 1;
     const WITH_WHEEL: usize = WHEEL_SCALE + 1;
     if inert_from(N_INS, f, q_c, p) {
-        on_leading::<N_INS>(f, q_c, p, dt_s)
+        series::<N_INS>(f, q_c, p, dt_s)
     } else if inert_from(PAPER, f, q_c, p) {
-        on_leading::<PAPER>(f, q_c, p, dt_s)
+        series::<PAPER>(f, q_c, p, dt_s)
     } else if inert_from(WITH_WHEEL, f, q_c, p) {
-        on_leading::<WITH_WHEEL>(f, q_c, p, dt_s)
+        series::<WITH_WHEEL>(f, q_c, p, dt_s)
     } else {
-        series(f, q_c, p, dt_s)
+        series::<N>(f, q_c, p, dt_s)
     }
 }
 
@@ -383,36 +384,18 @@ fn inert_from(first: usize, f: &StateMatrix, q_c: &StateVector, p: &StateMatrix)
     (first..N).all(|i| q_c[i] == 0.0 && p[(i, i)] == 0.0 && (0..N).all(|j| f[(i, j)] == 0.0))
 }
 
-/// The series on the leading `M` states, the others zero.
-fn on_leading<const M: usize>(
+/// The series of [`propagate_covariance`] on the leading `M` states; the others are zero.
+fn series<const M: usize>(
     f: &StateMatrix,
     q_c: &StateVector,
     p: &StateMatrix,
     dt_s: f64,
 ) -> StateMatrix {
-    let leading = series::<M>(
-        &f.fixed_view::<M, M>(0, 0).into_owned(),
-        &q_c.fixed_rows::<M>(0).into_owned(),
-        &p.fixed_view::<M, M>(0, 0).into_owned(),
-        dt_s,
-    );
-    let mut full = StateMatrix::zeros();
-    full.fixed_view_mut::<M, M>(0, 0).copy_from(&leading);
-    full
-}
-
-/// The series of [`propagate_covariance`] on M states.
-fn series<const M: usize>(
-    f: &Square<M>,
-    q_c: &SVector<f64, M>,
-    p: &Square<M>,
-    dt_s: f64,
-) -> Square<M> {
-    let f_sparse = SparseF::new(f);
+    let f_sparse = SparseF::<M>::new(f);
     // P is symmetric only up to rounding when it comes from outside: its rows are the
     // columns of Pᵀ. T₁ and T₂ are exactly symmetric, so they are their own row matrices.
     let mut fx: Rows<M> = [[0.0; M]; M];
-    f_sparse.times(&p.transpose(), &mut fx);
+    f_sparse.times(&Square::<M>::from_fn(|i, j| p[(j, i)]), &mut fx);
     let t1 = Square::<M>::from_fn(|i, j| {
         let l = lyapunov(&fx, i, j);
         if i == j {
@@ -425,10 +408,17 @@ fn series<const M: usize>(
     let t2 = Square::<M>::from_fn(|i, j| lyapunov(&fx, i, j));
     f_sparse.times(&t2, &mut fx);
     let (c1, c2, c3) = (dt_s, dt_s * dt_s * 0.5, dt_s.powi(3) / 6.0);
-    let p_new = Square::<M>::from_fn(|i, j| {
-        p[(i, j)] + t1[(i, j)] * c1 + t2[(i, j)] * c2 + lyapunov(&fx, i, j) * c3
-    });
-    Square::<M>::from_fn(|i, j| (p_new[(i, j)] + p_new[(j, i)]) * 0.5)
+    let p_new = |i, j| p[(i, j)] + t1[(i, j)] * c1 + t2[(i, j)] * c2 + lyapunov(&fx, i, j) * c3;
+    // Symmetric: each pair of entries once, from the mean of both triangles.
+    let mut out = StateMatrix::zeros();
+    for j in 0..M {
+        for i in 0..=j {
+            let v = (p_new(i, j) + p_new(j, i)) * 0.5;
+            out[(i, j)] = v;
+            out[(j, i)] = v;
+        }
+    }
+    out
 }
 
 #[cfg(test)]
@@ -604,7 +594,7 @@ mod tests {
                 p0.column_mut(i).fill(0.0);
             }
             let fast = propagate_covariance(&f, &q, &p0, 0.01);
-            let full = series(&f, &q, &p0, 0.01);
+            let full = series::<N>(&f, &q, &p0, 0.01);
             for (a, b) in fast.iter().zip(full.iter()) {
                 assert_eq!(a.to_bits(), b.to_bits());
             }

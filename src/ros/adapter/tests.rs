@@ -524,7 +524,7 @@ fn a_sustained_time_jump_resets_once_and_loses_no_sample() {
 #[test]
 fn a_flood_of_imu_samples_and_far_future_measurements_keep_the_buffers_bounded() {
     use crate::engine::standstill::MAX_WINDOW_SAMPLES;
-    use crate::engine::{MAX_BUFFERED_IMU_SAMPLES, MAX_PENDING_MEASUREMENTS};
+    use crate::engine::{MAX_BUFFERED_IMU_SAMPLES, MAX_PENDING_MEASUREMENTS, STATE_EVERY_STEPS};
     use crate::sim::SimEvent;
     // Issue 12, item 12: stamps 1 µs apart, and a fix 1000 s ahead, grew memory for good.
     let mut adapter = loose_adapter(OutputFrames::default());
@@ -555,6 +555,7 @@ fn a_flood_of_imu_samples_and_far_future_measurements_keep_the_buffers_bounded()
             adapter.on_fix(&outbound::receiver_fix(&fix, stamp, "gnss"));
             let b = adapter.engine().buffered();
             most.imu_samples = most.imu_samples.max(b.imu_samples);
+            most.steps = most.steps.max(b.steps);
             most.states = most.states.max(b.states);
             most.measurements = most.measurements.max(b.measurements);
             most.standstill_samples = most.standstill_samples.max(b.standstill_samples);
@@ -566,7 +567,8 @@ fn a_flood_of_imu_samples_and_far_future_measurements_keep_the_buffers_bounded()
     );
     assert_eq!(adapter.engine().init_phase(), None, "still running");
     assert_eq!(most.imu_samples, MAX_BUFFERED_IMU_SAMPLES);
-    assert_eq!(most.states, MAX_BUFFERED_IMU_SAMPLES);
+    assert_eq!(most.steps, MAX_BUFFERED_IMU_SAMPLES);
+    assert_eq!(most.states, MAX_BUFFERED_IMU_SAMPLES / STATE_EVERY_STEPS);
     assert!(most.measurements <= 1, "{most:?}");
     assert_eq!(most.standstill_samples, MAX_WINDOW_SAMPLES);
     let counters = adapter.engine().counters();
