@@ -29,7 +29,7 @@
 //!    A heading σ above [`super::heading_bank::BANK_ABOVE_RAD`] is resolved by the engine's bank of
 //!    heading hypotheses ([`super::heading_bank`]).
 //!    Loosely coupled after a divergence, the start in motion waits until the gyro bias
-//!    about the vertical is measured against the course ([`Initializer::vertical_gyro_bias`]).
+//!    about the vertical is measured against the course ([`super::vertical_bias`]).
 
 use nalgebra::{Matrix2, Matrix3, UnitQuaternion, Vector2, Vector3};
 
@@ -46,6 +46,7 @@ use crate::ins::{ImuSample, NavState};
 use super::fix_track::FixTrack;
 use super::standstill::MotionStatistics;
 use super::update::{sigma_model, GnssFix};
+use super::vertical_bias::{Course, VerticalBias, VerticalBiasSpan};
 
 /// 1-sigma of an acceleration along the body's forward axis that no GNSS speed difference
 /// measures (m/s²). Choice: a car's brisk acceleration or braking.
@@ -208,34 +209,9 @@ pub struct Initializer {
     /// The newest dual-antenna heading of the body.
     antenna_heading: Option<AntennaHeading>,
     /// A loosely-coupled restart after a divergence measures the vertical gyro bias before
-    /// it starts in motion ([`Initializer::vertical_gyro_bias`]); the span so far.
-    vertical_bias: Option<VerticalBiasSpan>,
+    /// it starts in motion ([`super::vertical_bias`]): whether it does, and the span so far.
     measure_vertical_bias: bool,
-}
-
-/// The gyro's turn about the vertical against the course's, over a span of moving fixes.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct VerticalBiasSpan {
-    first_t_s: f64,
-    /// Variance of the first course (rad²) and its lag (s).
-    first_var_rad2: f64,
-    first_lag_s: f64,
-    /// The newest fix's time and course (ENU yaw, rad).
-    last_t_s: f64,
-    last_yaw_rad: f64,
-    /// Change of the course since the first fix (unwrapped) and the gyro's turn about the
-    /// vertical, earth rate removed, over the same time (rad).
-    course_turn_rad: f64,
-    gyro_turn_rad: f64,
-}
-
-/// A vertical gyro bias measured in motion: the bias along the body's `up_b` (rad/s) and
-/// its 1-sigma.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct VerticalBias {
-    up_b: Vector3<f64>,
-    bias_rad_s: f64,
-    sigma_rad_s: f64,
+    vertical_bias: VerticalBiasSpan,
 }
 
 /// A dual-antenna pair's heading of the body's x axis.
@@ -269,8 +245,8 @@ impl Default for Initializer {
             velocity: None,
             gyro_bias_sigma_factor: 1.0,
             antenna_heading: None,
-            vertical_bias: None,
             measure_vertical_bias: false,
+            vertical_bias: VerticalBiasSpan::default(),
         }
     }
 }
@@ -326,31 +302,12 @@ impl Initializer {
     }
 
     /// The gyro bias about the vertical of a loosely-coupled restart in motion after a
-    /// divergence, from the gyro's turn against the course's over the moving fixes since
-    /// the span began; None until its 1-sigma is within the class's turn-on σ
-    /// (`imu.gyro_bias_deg_per_h`), or while not moving.
-    ///
-    /// Choice: measured, not assumed. With the 10× prior of
-    /// [`DIVERGED_GYRO_BIAS_SIGMA_FACTOR`] about the vertical too (5,000 °/h for a
-    /// consumer MEMS, 1.4 °/s) the heading of a filter started at once drifts by tens of
-    /// degrees on a straight road, where position fixes without a velocity do not see it:
-    /// after a consumer gyro's biases jumped tenfold the restarted filter (loosely coupled,
-    /// tests/divergence_monitor.rs) was 40° off in heading 35 s after its start (σ 27°),
-    /// beyond the linear range of an error-state filter, and its correction at the next
-    /// acceleration left roll, pitch and the accelerometer biases over-confident (2° against
-    /// a σ of 0.22°, 40 mg against 4 mg): NEES up to 276. With the vertical bias known to
-    /// the class's σ the same restart stayed at 21. So the restart starts like a first
-    /// start in motion, with the vertical bias no worse known than the class's turn-on σ.
-    /// The car must drive for it (about 30 s at 12 m/s) and publishes nothing meanwhile.
-    ///
-    /// The course rate is the gyro's rate about the vertical less its bias, taking the
-    /// body's forward axis along the course as the alignment in motion does: each end of
-    /// the span has the course's own variance and [`COURSE_SIGMA_RAD`] (side-slip). A
-    /// course carried forward by its lag with the raw rate holds the bias times the lag;
-    /// hence b = (gyro turn − course turn) / (span − change of lag). The gyro's turn
-    /// between fixes is the recent samples' mean rate (the last
-    /// [`super::standstill::WINDOW_S`]) times the interval; a longer interval starts a new
-    /// span.
+    /// divergence ([`super::vertical_bias`]), along the body's up axis `up_b`, from the
+    /// moving fixes since the span began; None until its 1-sigma is within the class's
+    /// turn-on σ (`imu.gyro_bias_deg_per_h`), or while not moving. The gyro's turn between
+    /// fixes is the recent samples' mean rate (the last [`super::standstill::WINDOW_S`])
+    /// times the interval; a longer interval starts a new span. The courses' side-slip is
+    /// [`COURSE_SIGMA_RAD`].
     fn vertical_gyro_bias(
         &mut self,
         t_s: f64,
@@ -358,47 +315,26 @@ impl Initializer {
         lat_rad: f64,
         recent: &MotionStatistics,
         config: &Config,
-    ) -> Option<VerticalBias> {
+    ) -> Option<(Vector3<f64>, VerticalBias)> {
         let moving = velocity.filter(|v| v.moving(config) && recent.count() >= 2);
         let (Some(v), Some(up_b)) = (moving, recent.mean_f().try_normalize(1e-9)) else {
-            self.vertical_bias = None;
+            self.vertical_bias.clear();
             return None;
         };
-        let yaw_rad = v.v_enu_mps[1].atan2(v.v_enu_mps[0]);
-        let var_rad2 = v.course_sigma_rad().powi(2) + COURSE_SIGMA_RAD.powi(2);
+        let course = Course {
+            t_s,
+            yaw_rad: v.v_enu_mps[1].atan2(v.v_enu_mps[0]),
+            var_rad2: v.course_sigma_rad().powi(2) + COURSE_SIGMA_RAD.powi(2),
+            lag_s: v.lag_s,
+        };
         let rate_rad_s = recent.mean_w().dot(&up_b) - earth::earth_rate_enu_rad_s(lat_rad)[2];
-        let fresh = VerticalBiasSpan {
-            first_t_s: t_s,
-            first_var_rad2: var_rad2,
-            first_lag_s: v.lag_s,
-            last_t_s: t_s,
-            last_yaw_rad: yaw_rad,
-            course_turn_rad: 0.0,
-            gyro_turn_rad: 0.0,
-        };
-        let span = match self.vertical_bias {
-            Some(s) if t_s <= s.last_t_s => return None,
-            Some(s) if t_s - s.last_t_s <= super::standstill::WINDOW_S * 1.1 => VerticalBiasSpan {
-                last_t_s: t_s,
-                last_yaw_rad: yaw_rad,
-                course_turn_rad: s.course_turn_rad
-                    + crate::ins::mechanization::wrap_pi(yaw_rad - s.last_yaw_rad),
-                gyro_turn_rad: s.gyro_turn_rad + rate_rad_s * (t_s - s.last_t_s),
-                ..s
-            },
-            _ => fresh,
-        };
-        self.vertical_bias = Some(span);
-        let span_s = (t_s - span.first_t_s) - (v.lag_s - span.first_lag_s);
-        if span_s <= 0.0 {
-            return None;
-        }
-        let sigma_rad_s = (span.first_var_rad2 + var_rad2).sqrt() / span_s;
-        (sigma_rad_s <= config.imu.gyro_bias_sigma_rad_s).then(|| VerticalBias {
-            up_b,
-            bias_rad_s: (span.gyro_turn_rad - span.course_turn_rad) / span_s,
-            sigma_rad_s,
-        })
+        let bias = self.vertical_bias.push(
+            course,
+            rate_rad_s,
+            super::standstill::WINDOW_S * 1.1,
+            config.imu.gyro_bias_sigma_rad_s,
+        )?;
+        Some((up_b, bias))
     }
 
     /// The σ of a gyro bias not measured at rest (rad/s).
@@ -601,9 +537,8 @@ impl Initializer {
             position_var,
         );
         init.heading_from_motion = from_motion;
-        if let Some(vb) = vertical_bias {
+        if let Some((u, vb)) = vertical_bias {
             // The bias along the vertical as measured; across it the prior's σ.
-            let u = vb.up_b;
             let across_var = self.turn_on_gyro_bias_sigma_rad_s(config).powi(2);
             let block = (Matrix3::identity() - u * u.transpose()) * across_var
                 + u * u.transpose() * vb.sigma_rad_s.powi(2);
