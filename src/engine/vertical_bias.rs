@@ -70,23 +70,24 @@ impl VerticalBiasSpan {
         max_sigma_rad_s: f64,
     ) -> Option<VerticalBias> {
         match (self.first, self.last) {
-            (Some(first), Some(last)) if course.t_s > last.t_s => {
-                if course.t_s - last.t_s <= max_gap_s {
-                    self.course_turn_rad += wrap_pi(course.yaw_rad - last.yaw_rad);
-                    self.gyro_turn_rad += rate_up_rad_s * (course.t_s - last.t_s);
-                    self.last = Some(course);
-                    let span_s = (course.t_s - first.t_s) - (course.lag_s - first.lag_s);
-                    if span_s <= 0.0 {
-                        return None;
-                    }
-                    let sigma_rad_s = (first.var_rad2 + course.var_rad2).sqrt() / span_s;
-                    return (sigma_rad_s <= max_sigma_rad_s).then(|| VerticalBias {
-                        bias_rad_s: (self.gyro_turn_rad - self.course_turn_rad) / span_s,
-                        sigma_rad_s,
-                    });
+            (Some(first), Some(last))
+                if course.t_s > last.t_s && course.t_s - last.t_s <= max_gap_s =>
+            {
+                self.course_turn_rad += wrap_pi(course.yaw_rad - last.yaw_rad);
+                self.gyro_turn_rad += rate_up_rad_s * (course.t_s - last.t_s);
+                self.last = Some(course);
+                let span_s = (course.t_s - first.t_s) - (course.lag_s - first.lag_s);
+                if span_s <= 0.0 {
+                    return None;
                 }
+                let sigma_rad_s = (first.var_rad2 + course.var_rad2).sqrt() / span_s;
+                return (sigma_rad_s <= max_sigma_rad_s).then(|| VerticalBias {
+                    bias_rad_s: (self.gyro_turn_rad - self.course_turn_rad) / span_s,
+                    sigma_rad_s,
+                });
             }
-            (Some(_), Some(_)) => return None,
+            // A stamp not after the last: ignored.
+            (Some(_), Some(last)) if course.t_s <= last.t_s => return None,
             _ => {}
         }
         *self = Self {
