@@ -12,9 +12,12 @@
 //!    solution (tightly coupled) or the receiver's fix (loosely coupled).
 //! 4. The heading is `init.heading_deg` (a compass heading) when given; otherwise a
 //!    dual-antenna pair's heading no older than [`ANTENNA_HEADING_AGE_S`] (with its σ: the
-//!    heading at rest); otherwise the direction of the GNSS velocity once the platform
-//!    moves, assuming the body's forward axis points along the motion (vehicles, walking
-//!    with the device ahead). Moving: the horizontal speed exceeds
+//!    heading at rest); otherwise, levelled at rest, the gyrocompass's
+//!    ([`super::gyrocompass`]: the earth rate's direction in the levelling's mean rate,
+//!    with its σ; only when that σ is below [`super::gyrocompass::MAX_SIGMA_RAD`], which
+//!    only navigation-grade gyros reach); otherwise the direction of the GNSS velocity
+//!    once the platform moves, assuming the body's forward axis points along the motion
+//!    (vehicles, walking with the device ahead). Moving: the horizontal speed exceeds
 //!    `init.heading_min_speed_mps` and is significant against its own covariance. Loosely coupled without a receiver velocity, the velocity is the
 //!    displacement of the fixes over up to [`super::fix_track::MAX_BASELINE_S`], and the platform moves
 //!    only once that displacement has been significant against the fixes' covariances for
@@ -44,6 +47,7 @@ use crate::ins::error_state::{
 use crate::ins::{ImuSample, NavState};
 
 use super::fix_track::FixTrack;
+use super::gyrocompass;
 use super::standstill::MotionStatistics;
 use super::update::{sigma_model, GnssFix};
 use super::vertical_bias::{Course, VerticalBias, VerticalBiasSpan};
@@ -174,6 +178,8 @@ struct Alignment {
     /// 1-sigma of roll, pitch and heading (rad).
     sigma_rad: [f64; 3],
     velocity_sigma_mps: f64,
+    /// The heading is the gyrocompass's (see [`Initializer::initial_state`]).
+    gyrocompass: bool,
 }
 
 #[derive(Debug, Clone)]
@@ -183,8 +189,18 @@ struct Attitude {
     /// Bias removed while propagating: the mean rate at rest (earth rate included).
     gyro_bias_rad_s: Vector3<f64>,
     last_t_s: f64,
-    /// The levelled attitude and the mean rate at rest, for the bias estimate at start.
-    at_rest: Option<(UnitQuaternion<f64>, Vector3<f64>)>,
+    /// The levelling at rest, for the gyrocompass and the bias estimate at start.
+    at_rest: Option<Rest>,
+}
+
+/// A levelling window at rest.
+#[derive(Debug, Clone, Copy)]
+struct Rest {
+    /// The levelled attitude (yaw as it was then: 0 or `init.heading_deg`).
+    q_level: UnitQuaternion<f64>,
+    /// The mean angular rate over the window (earth rate included).
+    mean_w_rad_s: Vector3<f64>,
+    window_s: f64,
 }
 
 /// The start-up state machine.
@@ -229,8 +245,10 @@ struct StartHeading {
     /// ENU yaw (rad).
     yaw_rad: f64,
     from_motion: bool,
-    /// Its 1-sigma when it comes with one (a dual antenna), rad.
+    /// Its 1-sigma when it comes with one (a dual antenna, the gyrocompass), rad.
     sigma_rad: Option<f64>,
+    /// From the gyrocompass: the horizontal gyro bias is the heading's (not measured).
+    gyrocompass: bool,
 }
 
 impl Default for Initializer {
@@ -381,6 +399,7 @@ impl Initializer {
                 v.t_s >= lev.t_start_s - SPEED_AGE_S && v.v_enu_mps.norm() > REST_SPEED_MAX_MPS
             });
             let (f, w) = (lev.stats.mean_f(), lev.stats.mean_w());
+            let window_s = lev.stats.duration_s();
             self.leveling = None;
             if !imu_at_rest || gnss_moving {
                 return;
@@ -395,7 +414,11 @@ impl Initializer {
                 q_nb,
                 gyro_bias_rad_s: w,
                 last_t_s: s.t_s,
-                at_rest: Some((q_nb, w)),
+                at_rest: Some(Rest {
+                    q_level: q_nb,
+                    mean_w_rad_s: w,
+                    window_s,
+                }),
             });
         }
     }
@@ -437,11 +460,12 @@ impl Initializer {
         let (alignment, from_motion) = match self.attitude.clone() {
             Some(attitude) => {
                 self.position_known = true;
-                let heading = self.heading(epoch.t_s, v_enu.as_ref(), config)?;
+                let heading =
+                    self.heading(epoch.t_s, v_enu.as_ref(), sol.pos_llh.lat_rad, config)?;
                 let q_nb = replace_yaw(&attitude.q_nb, heading.yaw_rad);
                 let course = self.velocity.filter(|_| heading.from_motion);
                 (
-                    Self::levelled(q_nb, course, heading.sigma_rad, config),
+                    Self::levelled(q_nb, course, &heading, config),
                     heading.from_motion,
                 )
             }
@@ -509,11 +533,12 @@ impl Initializer {
             Some(attitude) => {
                 self.position_known = true;
                 let v = velocity.filter(|v| fix.velocity_enu_mps.is_some() || v.moving(config));
-                let heading = self.heading(fix.t_s, v.map(|v| v.v_enu_mps).as_ref(), config)?;
+                let v_enu = v.map(|v| v.v_enu_mps);
+                let heading = self.heading(fix.t_s, v_enu.as_ref(), position.lat_rad, config)?;
                 let q_nb = replace_yaw(&attitude.q_nb, heading.yaw_rad);
                 let course = v.filter(|_| heading.from_motion);
                 (
-                    Self::levelled(q_nb, course, heading.sigma_rad, config),
+                    Self::levelled(q_nb, course, &heading, config),
                     heading.from_motion,
                 )
             }
@@ -612,16 +637,16 @@ impl Initializer {
 
     /// The levelled attitude turned to the heading found, with the configured 1-sigmas; a
     /// heading from the `course` of a GNSS velocity has at least the course's own
-    /// uncertainty and [`COURSE_SIGMA_RAD`]; one with its own σ (`heading_sigma_rad`, a
-    /// dual antenna) has that.
+    /// uncertainty and [`COURSE_SIGMA_RAD`]; one with its own σ (a dual antenna, the
+    /// gyrocompass) has that.
     fn levelled(
         q_nb: UnitQuaternion<f64>,
         course: Option<GnssVelocity>,
-        heading_sigma_rad: Option<f64>,
+        heading: &StartHeading,
         config: &Config,
     ) -> Alignment {
         let i = &config.init;
-        let heading_sigma = heading_sigma_rad.unwrap_or_else(|| {
+        let heading_sigma = heading.sigma_rad.unwrap_or_else(|| {
             course.map_or(i.heading_sigma_rad, |v| {
                 i.heading_sigma_rad
                     .max(v.course_sigma_rad().hypot(COURSE_SIGMA_RAD))
@@ -636,6 +661,7 @@ impl Initializer {
             q_nb,
             sigma_rad: [i.attitude_sigma_rad, i.attitude_sigma_rad, heading_sigma],
             velocity_sigma_mps,
+            gyrocompass: heading.gyrocompass,
         }
     }
 
@@ -692,14 +718,17 @@ impl Initializer {
                 heading_sigma,
             ],
             velocity_sigma_mps: i.velocity_sigma_mps.max(speed_sigma),
+            gyrocompass: false,
         })
     }
 
-    /// The heading of a start at `t_s` (see the module documentation); None while unknown.
+    /// The heading of a start at `t_s` at latitude `lat_rad` (see the module
+    /// documentation); None while unknown.
     fn heading(
         &self,
         t_s: f64,
         v_enu: Option<&Vector3<f64>>,
+        lat_rad: f64,
         config: &Config,
     ) -> Option<StartHeading> {
         if let Some(heading) = config.init.heading_rad {
@@ -707,6 +736,7 @@ impl Initializer {
                 yaw_rad: enu_yaw_of_heading(heading),
                 from_motion: false,
                 sigma_rad: None,
+                gyrocompass: false,
             });
         }
         if let Some(a) = self
@@ -717,14 +747,51 @@ impl Initializer {
                 yaw_rad: enu_yaw_of_heading(a.heading_rad),
                 from_motion: false,
                 sigma_rad: Some(a.sigma_rad),
+                gyrocompass: false,
             });
+        }
+        // The levelled attitude's heading, carried to now by the turn the gyros have seen
+        // since the levelling.
+        let compass = self.attitude.as_ref().and_then(|attitude| {
+            let rest = attitude.at_rest?;
+            let found = gyrocompass::gyrocompass(
+                &rest.q_level,
+                &rest.mean_w_rad_s,
+                rest.window_s,
+                lat_rad,
+                config,
+            )?;
+            let turned_rad = attitude.q_nb.euler_angles().2 - rest.q_level.euler_angles().2;
+            Some(StartHeading {
+                yaw_rad: found.yaw_rad + turned_rad,
+                from_motion: false,
+                sigma_rad: Some(found.sigma_rad),
+                gyrocompass: true,
+            })
+        });
+        if compass.is_some() {
+            return compass;
         }
         let v = v_enu?;
         (v[0].hypot(v[1]) >= config.init.heading_min_speed_mps).then(|| StartHeading {
             yaw_rad: v[1].atan2(v[0]),
             from_motion: true,
             sigma_rad: None,
+            gyrocompass: false,
         })
+    }
+
+    /// The attitude at the levelling turned to the start's yaw `q_nb` (by the yaw found
+    /// since), and the mean rate at rest; None without a levelling at rest.
+    fn levelled_at_rest(
+        &self,
+        q_nb: &UnitQuaternion<f64>,
+    ) -> Option<(UnitQuaternion<f64>, Vector3<f64>)> {
+        let attitude = self.attitude.as_ref()?;
+        let rest = attitude.at_rest?;
+        let yaw_offset = q_nb.euler_angles().2 - attitude.q_nb.euler_angles().2;
+        let q_rest = UnitQuaternion::from_euler_angles(0.0, 0.0, yaw_offset) * rest.q_level;
+        Some((q_rest, rest.mean_w_rad_s))
     }
 
     fn initial_state(
@@ -780,6 +847,20 @@ impl Initializer {
         });
         let gb = gb.powi(2);
         set3(&mut cov, GYRO_BIAS, [gb, gb, gb]);
+        let q_rest = self.levelled_at_rest(&q_nb);
+        if let Some((q_rest, _)) = q_rest.filter(|_| alignment.gyrocompass) {
+            // Choice: after a gyrocompass the horizontal bias keeps the class's turn-on σ
+            // (resolved in the levelled frame): its part across north is the heading's
+            // error (inseparable at rest, see [`super::gyrocompass`]), and its part along
+            // north, which the mean rate's magnitude less Ω cos L measures, is left to the
+            // filter, since over a few seconds that measurement (the rate noise's mean) is
+            // coarser than a navigation-grade class's σ. The vertical one is as above.
+            let horizontal = turn_on_sigma_rad_s.powi(2);
+            let c_nb = q_rest.to_rotation_matrix().into_inner();
+            let p_n = Matrix3::from_diagonal(&Vector3::new(horizontal, horizontal, gb));
+            cov.fixed_view_mut::<3, 3>(GYRO_BIAS, GYRO_BIAS)
+                .copy_from(&(c_nb.transpose() * p_n * c_nb));
+        }
         let gm = config.imu.gyro_markov_sigma_rad_s.powi(2);
         set3(&mut cov, GYRO_GM, [gm, gm, gm]);
         let ab = config.imu.accel_bias_sigma_m_s2.powi(2);
@@ -802,21 +883,22 @@ impl Initializer {
             set3(&mut cov, ACC_SCALE, [a, a, a]);
         }
         // The bias at rest is the mean rate less the earth rate seen in the body frame,
-        // which needs the heading: the levelled attitude turned by the yaw found since. An
-        // alignment in motion has no bias (zero, with the class's σ above).
-        let gyro_bias_rad_s = self
-            .attitude
-            .as_ref()
-            .map_or_else(Vector3::zeros, |attitude| {
-                attitude
-                    .at_rest
-                    .map_or(attitude.gyro_bias_rad_s, |(q_level, w_rest)| {
-                        let yaw_offset = q_nb.euler_angles().2 - attitude.q_nb.euler_angles().2;
-                        let q_rest =
-                            UnitQuaternion::from_euler_angles(0.0, 0.0, yaw_offset) * q_level;
-                        w_rest - q_rest.inverse() * earth::earth_rate_enu_rad_s(p.lat_rad)
-                    })
-            });
+        // which needs the heading: the levelled attitude turned by the yaw found since
+        // (after a gyrocompass only its vertical part: the horizontal one is zero, above).
+        // An alignment in motion has no bias (zero, with the class's σ above).
+        let gyro_bias_rad_s = match (&self.attitude, q_rest) {
+            (None, _) => Vector3::zeros(),
+            (Some(attitude), None) => attitude.gyro_bias_rad_s,
+            (Some(_), Some((q_rest, w_rest))) => {
+                let earth_n = earth::earth_rate_enu_rad_s(p.lat_rad);
+                if alignment.gyrocompass {
+                    let vertical = (q_rest * w_rest)[2] - earth_n[2];
+                    q_rest.inverse() * Vector3::new(0.0, 0.0, vertical)
+                } else {
+                    w_rest - q_rest.inverse() * earth_n
+                }
+            }
+        };
         InitialState {
             nav,
             gyro_bias_rad_s,

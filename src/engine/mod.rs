@@ -44,6 +44,7 @@ pub mod divergence;
 mod dual_antenna;
 mod filter_state;
 mod fix_track;
+pub mod gyrocompass;
 pub mod heading_bank;
 pub mod imu_screen;
 mod initializer;
