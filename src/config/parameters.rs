@@ -538,9 +538,11 @@ parameter_table! {
     /// Start-up (alignment) and the initial 1-sigma of every state block.
     section init: InitConfig {
         /// Known initial heading of the body x axis, clockwise from true north (compass;
-        /// 0 = north, 90 = east; ENU yaw = 90 deg - heading). null = taken from the GNSS
-        /// velocity once the speed exceeds heading_min_speed_mps (heading is not
-        /// observable at rest).
+        /// 0 = north, 90 = east; ENU yaw = 90 deg - heading). null = a dual-antenna
+        /// heading, else at rest the gyrocompass's (the earth rate's direction in the
+        /// levelling's mean rate; only when its 1-sigma from the imu.gyro_* noise is
+        /// below 1 deg, which navigation-grade gyros reach), else taken from the GNSS
+        /// velocity once the speed exceeds heading_min_speed_mps.
         heading_rad: Option<f64> ["heading_deg": Option<f64>] = None,
             unit "deg", range Range::Within(Interval::closed(-360.0, 360.0)), at_start,
             si Scale::to("rad", RAD_PER_DEG);
