@@ -31,8 +31,6 @@
 //!    [`COURSE_SIGMA_RAD`] in the heading, the unknown acceleration in roll and pitch.
 //!    A heading σ above [`super::heading_bank::BANK_ABOVE_RAD`] is resolved by the engine's bank of
 //!    heading hypotheses ([`super::heading_bank`]).
-//!    Loosely coupled after a divergence, the start in motion waits until the gyro bias
-//!    about the vertical is measured against the course ([`super::vertical_bias`]).
 
 use nalgebra::{Matrix2, Matrix3, UnitQuaternion, Vector2, Vector3};
 
@@ -50,7 +48,6 @@ use super::fix_track::FixTrack;
 use super::gyrocompass;
 use super::standstill::MotionStatistics;
 use super::update::{sigma_model, GnssFix};
-use super::vertical_bias::{Course, VerticalBias, VerticalBiasSpan};
 
 /// 1-sigma of an acceleration along the body's forward axis that no GNSS speed difference
 /// measures (m/s²). Choice: a car's brisk acceleration or braking.
@@ -140,10 +137,6 @@ struct GnssVelocity {
     extrapolation_sigma_mps: f64,
     /// False for a displacement of fixes not yet significant for [`MOTION_EPOCHS`].
     confirmed: bool,
-    /// How long the velocity was carried forward with the raw gyro rate (s): 0 for a
-    /// receiver's velocity; for the fixes' line, its lag (see
-    /// [`Initializer::track_velocity`]).
-    lag_s: f64,
 }
 
 impl GnssVelocity {
@@ -224,10 +217,6 @@ pub struct Initializer {
     gyro_bias_sigma_factor: f64,
     /// The newest dual-antenna heading of the body.
     antenna_heading: Option<AntennaHeading>,
-    /// A loosely-coupled restart after a divergence measures the vertical gyro bias before
-    /// it starts in motion ([`super::vertical_bias`]): whether it does, and the span so far.
-    measure_vertical_bias: bool,
-    vertical_bias: VerticalBiasSpan,
 }
 
 /// A dual-antenna pair's heading of the body's x axis.
@@ -263,8 +252,6 @@ impl Default for Initializer {
             velocity: None,
             gyro_bias_sigma_factor: 1.0,
             antenna_heading: None,
-            measure_vertical_bias: false,
-            vertical_bias: VerticalBiasSpan::default(),
         }
     }
 }
@@ -308,51 +295,11 @@ impl Initializer {
     /// degrees while its σ says tenths), and a restart from them stays over-confident for
     /// minutes. The start-up aligns again — at rest by levelling, in motion from the GNSS
     /// course and the specific force (with the heading bank when that heading is coarse).
-    ///
-    /// Loosely coupled, a start in motion also waits until the gyro bias about the vertical
-    /// is measured ([`Self::vertical_gyro_bias`]).
     pub fn after_divergence() -> Self {
         Self {
             gyro_bias_sigma_factor: DIVERGED_GYRO_BIAS_SIGMA_FACTOR,
-            measure_vertical_bias: true,
             ..Self::default()
         }
-    }
-
-    /// The gyro bias about the vertical of a loosely-coupled restart in motion after a
-    /// divergence ([`super::vertical_bias`]), along the body's up axis `up_b`, from the
-    /// moving fixes since the span began; None until its 1-sigma is within the class's
-    /// turn-on σ (`imu.gyro_bias_deg_per_h`), or while not moving. The gyro's turn between
-    /// fixes is the recent samples' mean rate (the last [`super::standstill::WINDOW_S`])
-    /// times the interval; a longer interval starts a new span. The courses' side-slip is
-    /// [`COURSE_SIGMA_RAD`].
-    fn vertical_gyro_bias(
-        &mut self,
-        t_s: f64,
-        velocity: Option<GnssVelocity>,
-        lat_rad: f64,
-        recent: &MotionStatistics,
-        config: &Config,
-    ) -> Option<(Vector3<f64>, VerticalBias)> {
-        let moving = velocity.filter(|v| v.moving(config) && recent.count() >= 2);
-        let (Some(v), Some(up_b)) = (moving, recent.mean_f().try_normalize(1e-9)) else {
-            self.vertical_bias.clear();
-            return None;
-        };
-        let course = Course {
-            t_s,
-            yaw_rad: v.v_enu_mps[1].atan2(v.v_enu_mps[0]),
-            var_rad2: v.course_sigma_rad().powi(2) + COURSE_SIGMA_RAD.powi(2),
-            lag_s: v.lag_s,
-        };
-        let rate_rad_s = recent.mean_w().dot(&up_b) - earth::earth_rate_enu_rad_s(lat_rad)[2];
-        let bias = self.vertical_bias.push(
-            course,
-            rate_rad_s,
-            super::standstill::WINDOW_S * 1.1,
-            config.imu.gyro_bias_sigma_rad_s,
-        )?;
-        Some((up_b, bias))
     }
 
     /// The σ of a gyro bias not measured at rest (rad/s).
@@ -453,7 +400,6 @@ impl Initializer {
                 cov_h_m2_s2: cov.fixed_view::<2, 2>(0, 0).into(),
                 extrapolation_sigma_mps: 0.0,
                 confirmed: true,
-                lag_s: 0.0,
             });
         }
         let position_var = sol.covariance.fixed_view::<3, 3>(0, 0).trace() / 3.0;
@@ -516,7 +462,6 @@ impl Initializer {
                     cov_h_m2_s2: cov.fixed_view::<2, 2>(0, 0).into(),
                     extrapolation_sigma_mps: 0.0,
                     confirmed: true,
-                    lag_s: 0.0,
                 };
                 (Some(velocity), fix.position, fix_var)
             }
@@ -528,7 +473,6 @@ impl Initializer {
         if velocity.is_some() {
             self.velocity = velocity;
         }
-        let mut vertical_bias = None;
         let (alignment, from_motion) = match self.attitude.clone() {
             Some(attitude) => {
                 self.position_known = true;
@@ -542,16 +486,7 @@ impl Initializer {
                     heading.from_motion,
                 )
             }
-            None => {
-                let vertical = self.measure_vertical_bias.then(|| {
-                    self.vertical_gyro_bias(fix.t_s, velocity, fix.position.lat_rad, recent, config)
-                });
-                if vertical == Some(None) {
-                    return None;
-                }
-                vertical_bias = vertical.flatten();
-                (self.align_in_motion(previous, recent, config)?, true)
-            }
+            None => (self.align_in_motion(previous, recent, config)?, true),
         };
         let mut init = self.initial_state(
             fix.t_s,
@@ -562,16 +497,6 @@ impl Initializer {
             position_var,
         );
         init.heading_from_motion = from_motion;
-        if let Some((u, vb)) = vertical_bias {
-            // The bias along the vertical as measured; across it the prior's σ.
-            let across_var = self.turn_on_gyro_bias_sigma_rad_s(config).powi(2);
-            let block = (Matrix3::identity() - u * u.transpose()) * across_var
-                + u * u.transpose() * vb.sigma_rad_s.powi(2);
-            init.p
-                .fixed_view_mut::<3, 3>(GYRO_BIAS, GYRO_BIAS)
-                .copy_from(&block);
-            init.gyro_bias_rad_s = u * vb.bias_rad_s;
-        }
         Some(init)
     }
 
@@ -629,7 +554,6 @@ impl Initializer {
             cov_h_m2_s2: rotation.matrix() * fit.cov_v_h_m2_s2 * rotation.matrix().transpose(),
             extrapolation_sigma_mps: 0.5 * speed_change_mps.abs(),
             confirmed: self.moving_fixes >= MOTION_EPOCHS,
-            lag_s: fit.lag_s,
         };
         let position_var_m2 = fit.position_var_m2 + (0.5 * shortfall_m).powi(2);
         Some((velocity, position, position_var_m2))

@@ -57,7 +57,6 @@ mod retune;
 pub mod standstill;
 mod start_up;
 pub mod update;
-mod vertical_bias;
 mod wheel_odometry;
 
 use std::collections::VecDeque;
