@@ -105,7 +105,9 @@ pub const MAX_BUFFERED_IMU_SAMPLES: usize = 10_000;
 /// more samples (a few tens of microseconds), and saves copying a state (about 6 KB) on
 /// every sample, a tenth of the engine's time at 200 Hz. The re-integrated states are the
 /// ones first computed (the same steps on the same samples), except where an adaptive
-/// scheme has learned since, as for the samples after the measurement.
+/// scheme has learned since, as for the samples after the measurement. The reach back
+/// shortens by up to nine samples: a measurement older than the oldest kept state is
+/// refused as too old.
 pub const STATE_EVERY_STEPS: usize = 10;
 
 /// Most measurements waiting for the IMU to pass their time.
