@@ -9,6 +9,7 @@ use crate::earth::{self, Llh};
 use crate::engine::Solution;
 use crate::ins::error_state::{DP, DV, N, PHI};
 use crate::ins::mechanization::wrap_pi;
+use crate::ins::NavState;
 
 /// One reference sample. Velocity and attitude are optional (a GNSS reference may have
 /// neither).
@@ -18,6 +19,19 @@ pub struct TruthSample {
     pub p: Llh,
     pub v_n: Option<Vector3<f64>>,
     pub q_nb: Option<UnitQuaternion<f64>>,
+}
+
+impl From<&NavState> for TruthSample {
+    /// A full reference (position, velocity and attitude) from a true state, such as the
+    /// simulator's.
+    fn from(nav: &NavState) -> Self {
+        Self {
+            t_s: nav.t_s,
+            p: nav.p,
+            v_n: Some(nav.v_n),
+            q_nb: Some(nav.q_nb),
+        }
+    }
 }
 
 /// A reference trajectory, interpolated linearly in time (attitude by slerp).

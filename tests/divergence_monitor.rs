@@ -168,12 +168,7 @@ fn run_with(
         let Some(state) = engine.state() else {
             continue;
         };
-        let reference = eval::TruthSample {
-            t_s: t,
-            p: truth.nav.p,
-            v_n: Some(truth.nav.v_n),
-            q_nb: Some(truth.nav.q_nb),
-        };
+        let reference = eval::TruthSample::from(&truth.nav);
         let error = eval::solution_error(&state.solution(), &reference);
         if result.resets.is_empty() {
             let e = error.position_enu_m.norm();

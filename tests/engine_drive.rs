@@ -122,12 +122,7 @@ fn run_drive(config: Config) -> Metrics {
             // Score once per second, at the solution right after the update.
             if let Some(state) = engine.state() {
                 if t_init.is_some_and(|t0: f64| t - t0 >= SETTLING_S) {
-                    let reference = eval::TruthSample {
-                        t_s: t,
-                        p: truth.nav.p,
-                        v_n: Some(truth.nav.v_n),
-                        q_nb: Some(truth.nav.q_nb),
-                    };
+                    let reference = eval::TruthSample::from(&truth.nav);
                     scored.push(eval::solution_error(&state.solution(), &reference));
                 }
             }

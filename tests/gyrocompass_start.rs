@@ -121,12 +121,7 @@ fn run(trajectory: &Trajectory, spec: &ImuErrorSpec, config: Config, seed: u64) 
         if !(epoch_due || initialized.is_some()) {
             continue;
         }
-        let reference = eval::TruthSample {
-            t_s: t,
-            p: truth.nav.p,
-            v_n: Some(truth.nav.v_n),
-            q_nb: Some(truth.nav.q_nb),
-        };
+        let reference = eval::TruthSample::from(&truth.nav);
         let error = eval::solution_error(&state.solution(), &reference);
         let error_deg = error.attitude_rpy_rad.unwrap()[2].to_degrees();
         let sigma_deg = state.p[(PHI + 2, PHI + 2)].sqrt().to_degrees();

@@ -113,12 +113,7 @@ fn drive(start: Start) -> (TrajectorySpec, f64) {
 /// The errors of the filter's solution against the truth `nav` (at the same time), and
 /// its yaw error (deg).
 fn error_against(state: &FilterState, nav: &NavState) -> (eval::SolutionError, f64) {
-    let reference = eval::TruthSample {
-        t_s: nav.t_s,
-        p: nav.p,
-        v_n: Some(nav.v_n),
-        q_nb: Some(nav.q_nb),
-    };
+    let reference = eval::TruthSample::from(nav);
     let error = eval::solution_error(&state.solution(), &reference);
     let yaw_deg = error.attitude_rpy_rad.unwrap()[2].to_degrees().abs();
     (error, yaw_deg)

@@ -17,12 +17,9 @@ pub fn scenario_inputs(
             Err(e) => vec![Err(e)],
             Ok(SimEvent::Imu(s)) => vec![Ok(SessionInput::Imu(s))],
             Ok(SimEvent::Truth(t)) => {
-                vec![Ok(SessionInput::Reference(Reference::Truth(TruthSample {
-                    t_s: t.nav.t_s,
-                    p: t.nav.p,
-                    v_n: Some(t.nav.v_n),
-                    q_nb: Some(t.nav.q_nb),
-                })))]
+                vec![Ok(SessionInput::Reference(Reference::Truth(
+                    TruthSample::from(&t.nav),
+                )))]
             }
             Ok(SimEvent::Environment { t_s, name, .. }) => {
                 vec![Ok(SessionInput::Reference(Reference::Environment {
