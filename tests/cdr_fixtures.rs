@@ -522,7 +522,7 @@ fn gnss_fixture_converts_to_the_core_epoch() {
     let gps = &epoch.satellites[0];
     assert_eq!(gps.sat.constellation, Constellation::Gps);
     assert_eq!(gps.sat.prn, 5);
-    assert_eq!(gps.pseudorange_m, 21_456_789.125);
+    assert_eq!(gps.pseudorange_m, Some(21_456_789.125));
     assert_eq!(gps.pseudorange_rate_mps, Some(-345.5));
     assert_eq!(gps.pseudorange_sigma_m, Some(2.5));
     assert_eq!(gps.cn0_dbhz, Some(45.25));

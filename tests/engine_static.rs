@@ -234,7 +234,7 @@ fn a_kilometre_pseudorange_error_is_rejected_by_the_gate() {
     let mut run = Run::new(7);
     run.run(0.0, 30.0);
     let mut epoch = run.scenario.gnss(30.0);
-    epoch.satellites[2].pseudorange_m += 1000.0;
+    epoch.satellites[2].pseudorange_m = epoch.satellites[2].pseudorange_m.map(|p| p + 1000.0);
     let bad = epoch.satellites[2].sat;
     let out = push_epoch_at(&mut run, epoch);
     let report = epoch_report(&out);
@@ -280,7 +280,7 @@ fn non_finite_gnss_fields_are_rejected_per_satellite_or_per_epoch() {
     let mut run = Run::new(9);
     run.run(0.0, 20.0);
     let mut epoch = run.scenario.gnss(20.0);
-    epoch.satellites[0].pseudorange_m = f64::NAN;
+    epoch.satellites[0].pseudorange_m = Some(f64::NAN);
     epoch.satellites[1].sat_pos_ecef_m[0] = f64::INFINITY;
     epoch.satellites[2].sat_clock_bias_s = f64::NAN;
     epoch.satellites[3].pseudorange_rate_mps = Some(f64::NAN);

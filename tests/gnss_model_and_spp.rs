@@ -82,7 +82,7 @@ fn prediction_at_the_true_state_reproduces_simulated_observations() {
                 )
                 .unwrap();
                 assert!(p.iono_m > 0.0 && p.tropo_m > 1.5);
-                worst_pr = worst_pr.max((obs.pseudorange_m - p.pseudorange_m).abs());
+                worst_pr = worst_pr.max((obs.pseudorange_m.unwrap() - p.pseudorange_m).abs());
                 let rate = obs.pseudorange_rate_mps.unwrap();
                 worst_rate = worst_rate.max((rate - p.pseudorange_rate_mps).abs());
                 count += 1;
@@ -184,7 +184,7 @@ fn spp_covariance_matches_the_error_spread_under_modelled_noise() {
             )
             .unwrap();
             let sigma = config.sigma.pseudorange_sigma_m(obs, Some(p.elevation_rad));
-            obs.pseudorange_m += sigma * gauss.next();
+            obs.pseudorange_m = obs.pseudorange_m.map(|p| p + sigma * gauss.next());
         }
         let sol = solve_spp(&noisy, &config).unwrap();
         let e = nalgebra::Vector4::new(
@@ -219,7 +219,7 @@ fn spp_rejects_a_gross_outlier_and_keeps_the_truth() {
         .iter_mut()
         .find(|o| o.sat == target)
         .unwrap();
-    obs.pseudorange_m += 150.0;
+    obs.pseudorange_m = obs.pseudorange_m.map(|p| p + 150.0);
     let sol = solve_spp(&epoch, &config).unwrap();
     assert!(sol.excluded.iter().any(|e| e.sat == target
         && matches!(e.reason, Exclusion::Outlier { standardized_residual } if standardized_residual > 4.0)));
@@ -299,7 +299,7 @@ fn spp_reports_too_few_satellites_and_missing_rates() {
         })
     );
     // A corrupt satellite is excluded, not fatal.
-    epoch.satellites[0].pseudorange_m = f64::NAN;
+    epoch.satellites[0].pseudorange_m = Some(f64::NAN);
     let sol = solve_spp(&epoch, &config).unwrap();
     assert!(matches!(sol.excluded[0].reason, Exclusion::Invalid(_)));
     assert!((sol.pos_ecef_m - rx.pos_ecef_m).norm() < MAX_SPP_POS_ERR_M);

@@ -20,17 +20,28 @@ fn log() -> UbxLog {
 #[test]
 fn iono_free_epochs_combine_two_signals_with_their_group_delays() {
     let log = log();
-    let (mut checked, mut gps, mut galileo, mut single) = (0, 0, 0, 0);
+    let (mut checked, mut gps, mut galileo, mut single, mut phase_only) = (0, 0, 0, 0, 0);
     for raw in &log.rawx {
         let free = build_epoch_with(raw, &log.store, None, IonosphereMode::IonoFree);
         let one = build_epoch_with(raw, &log.store, None, IonosphereMode::Broadcast);
         single += free.stats.single_frequency;
         for (obs, code) in free.epoch.satellites.iter().zip(&free.signals) {
             let RangingCode::IonoFree { first, second } = *code else {
-                panic!(
-                    "{}: single-frequency {code:?} in an ionosphere-free epoch",
-                    obs.sat
+                // A single signal beside the pairs: its phase and rate only, never its
+                // range (the ionosphere would come back with it as a bias).
+                let k = one.epoch.satellites.iter().position(|s| s.sat == obs.sat);
+                let single_frequency = &one.epoch.satellites[k.unwrap()];
+                assert_eq!(one.signals[k.unwrap()], *code, "{}", obs.sat);
+                assert_eq!((obs.pseudorange_m, obs.pseudorange_sigma_m), (None, None));
+                assert!(obs.carrier_phase.is_some(), "{}", obs.sat);
+                assert_eq!(obs.carrier_phase, single_frequency.carrier_phase);
+                assert_eq!(
+                    obs.pseudorange_rate_mps,
+                    single_frequency.pseudorange_rate_mps
                 );
+                assert_eq!(obs.sat_pos_ecef_m, single_frequency.sat_pos_ecef_m);
+                phase_only += 1;
+                continue;
             };
             // The engine must add no ionosphere model on top.
             assert_eq!(obs.iono_delay_m, Some(0.0));
@@ -48,9 +59,8 @@ fn iono_free_epochs_combine_two_signals_with_their_group_delays() {
             let (a1, a2) =
                 iono_free_coefficients(first.carrier_frequency_hz(), second.carrier_frequency_hz())
                     .unwrap();
-            assert!(
-                (obs.pseudorange_m - (a1 * m1.pseudorange_m + a2 * m2.pseudorange_m)).abs() < 1e-6
-            );
+            let combined_m = a1 * m1.pseudorange_m + a2 * m2.pseudorange_m;
+            assert!((obs.pseudorange_m.unwrap() - combined_m).abs() < 1e-6);
             let sigma = (a1 * m1.pseudorange_sigma_m).hypot(a2 * m2.pseudorange_sigma_m);
             assert!((obs.pseudorange_sigma_m.unwrap() - sigma).abs() < 1e-12);
             // The rate: the first signal's Doppler.
@@ -89,10 +99,17 @@ fn iono_free_epochs_combine_two_signals_with_their_group_delays() {
             checked += 1;
         }
     }
-    println!("{checked} satellite-epochs checked ({gps} GPS, {galileo} Galileo); {single} left out as single-frequency");
+    println!(
+        "{checked} satellite-epochs checked ({gps} GPS, {galileo} Galileo); {single} \
+         single-frequency, {phase_only} of them kept for their phase"
+    );
     assert!(gps > 1500 && galileo > 2000, "{gps} GPS, {galileo} Galileo");
     // BeiDou: the log has B1C, B2a and B3I but no B1I, and D1 gives no B1C/B2a group delay.
     assert!(single > 3000, "{single} single-frequency satellite-epochs");
+    assert!(
+        phase_only > 3000 && phase_only <= single,
+        "{phase_only} of {single} kept for their phase"
+    );
 }
 
 /// ENU error (m) of a solution against the NAV-PVT solution of the same epoch.
@@ -180,12 +197,13 @@ fn reference_residuals(log: &UbxLog) -> ReferenceResiduals {
             .satellites
             .iter()
             .filter_map(|obs| {
+                let pseudorange_m = obs.pseudorange_m?;
                 let p = predict(obs, &r, &Vector3::zeros(), 0.0, 0.0, None, tow).ok()?;
                 let group = usize::from(obs.sat.constellation == Constellation::Galileo);
                 (p.elevation_rad > 10f64.to_radians()).then(|| {
                     (
                         rot_ecef_to_enu(&reference) * p.los_ecef,
-                        obs.pseudorange_m - p.pseudorange_m,
+                        pseudorange_m - p.pseudorange_m,
                         group,
                     )
                 })

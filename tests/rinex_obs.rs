@@ -377,7 +377,7 @@ fn rinex_epochs_equal_the_ubx_epochs_they_were_converted_from() {
                 .find(|b| b.sat == a.sat)
                 .unwrap_or_else(|| panic!("{}: in RINEX, not in UBX", a.sat));
             // RINEX keeps 1 mm of pseudo-range and 1 mHz of Doppler.
-            assert!((a.pseudorange_m - b.pseudorange_m).abs() <= 0.5e-3 + 1e-9);
+            assert!((a.pseudorange_m.unwrap() - b.pseudorange_m.unwrap()).abs() <= 0.5e-3 + 1e-9);
             let rate_tolerance = 0.5e-3 * 0.1903 + 1e-9;
             let (ra, rb) = (
                 a.pseudorange_rate_mps.unwrap(),

@@ -61,7 +61,7 @@ fn hash_events(events: &[SimEvent]) -> u64 {
                 f(epoch.gps_time_of_week_s);
                 for o in &epoch.satellites {
                     f(o.sat.prn as f64);
-                    f(o.pseudorange_m);
+                    f(o.pseudorange_m.unwrap_or(f64::NAN));
                     f(o.pseudorange_rate_mps.unwrap_or(f64::NAN));
                     f(o.cn0_dbhz.unwrap_or(f64::NAN));
                     o.sat_pos_ecef_m.iter().for_each(|&x| f(x));
@@ -227,7 +227,7 @@ fn residuals(scenario: &Scenario, epoch: &GnssEpoch, truth: &GnssTruth) -> Vec<(
                 epoch.gps_time_of_week_s,
             )
             .unwrap();
-            let mut r = obs.pseudorange_m - pred.pseudorange_m;
+            let mut r = obs.pseudorange_m.unwrap() - pred.pseudorange_m;
             if obs.iono_delay_m.is_none() {
                 r -= (atm.iono_truth_scale - 1.0) * pred.iono_m;
             }
@@ -847,7 +847,7 @@ fn carrier_phases_follow_the_range_with_their_own_noise() {
         for (obs, err) in epoch.satellites.iter().zip(&truth.satellites) {
             let phase = obs.carrier_phase.unwrap();
             let lambda_m = phase.wavelength_m.unwrap();
-            let code_m = obs.pseudorange_m - err.pseudorange_error_m;
+            let code_m = obs.pseudorange_m.unwrap() - err.pseudorange_error_m;
             let now = (
                 epoch.t_s,
                 phase.cycles * lambda_m,

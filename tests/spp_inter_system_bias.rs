@@ -36,7 +36,7 @@ fn epoch_with_bias(site: &Llh, t_s: f64) -> (GnssEpoch, ReceiverTruth) {
     // Every other satellite becomes a "Galileo" satellite with the bias.
     for obs in epoch.satellites.iter_mut().skip(1).step_by(2) {
         obs.sat.constellation = Constellation::Galileo;
-        obs.pseudorange_m += BIAS_M;
+        obs.pseudorange_m = obs.pseudorange_m.map(|p| p + BIAS_M);
     }
     (epoch, rx)
 }

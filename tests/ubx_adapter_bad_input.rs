@@ -11,7 +11,8 @@ mod ubx_robot_support;
 use adaptive_gnss_ins::gnss::ephemeris::{EphemerisStore, GpsTime};
 use adaptive_gnss_ins::gnss::ionosphere::IonosphereMode;
 use adaptive_gnss_ins::gnss::ubx::{
-    build_epoch_with, lnav_subframe, read_ubx_log, sat_id, RawMeasurement, RawX, TrackingStatus,
+    build_epoch_with, lnav_subframe, read_ubx_log, sat_id, signal, RawMeasurement, RawX,
+    TrackingStatus,
 };
 use adaptive_gnss_ins::gnss::{Constellation, SatId};
 use adaptive_gnss_ins::ros::cdr;
@@ -448,15 +449,17 @@ fn an_ephemeris_serves_across_the_end_of_the_gps_week() {
 }
 
 /// The live path fills the carrier fields through the same code as `convert`: the first
-/// signal's phase (GPS L1 C/A, Galileo E1 in the default ionosphere-free mode) in cycles
-/// of its wavelength, with the receiver's σ and lock time, as the RAWX block says.
+/// signal's phase (GPS L1 C/A, Galileo E1 in the default ionosphere-free mode; a
+/// satellite without a pair, kept for its phase alone, has no range and its single
+/// signal's phase) in cycles of its wavelength, with the receiver's σ and lock time, as
+/// the RAWX block says.
 #[test]
 fn published_epochs_carry_the_receivers_carrier_phase() {
     let (bytes, _) = walk_log();
     let log = read_ubx_log(&bytes);
     let (_, out) = clean();
     let l1_m = 299_792_458.0 / 1_575.42e6;
-    let (mut with_phase, mut satellites) = (0, 0);
+    let (mut with_phase, mut satellites, mut phase_only) = (0, 0, 0);
     for m in &out {
         let raw = log
             .rawx
@@ -469,7 +472,11 @@ fn published_epochs_carry_the_receivers_carrier_phase() {
                 continue;
             }
             with_phase += 1;
-            assert!((s.carrier_wavelength_m - l1_m).abs() < 1e-12, "{s:?}");
+            if s.pseudorange_m.is_nan() {
+                phase_only += 1;
+            } else {
+                assert!((s.carrier_wavelength_m - l1_m).abs() < 1e-12, "{s:?}");
+            }
             assert!((0.0..=64.5).contains(&s.carrier_lock_time_s), "{s:?}");
             assert!(s.carrier_phase_sigma_cycles > 0.0, "{s:?}");
             let block = raw
@@ -483,9 +490,15 @@ fn published_epochs_carry_the_receivers_carrier_phase() {
                 .unwrap_or_else(|| panic!("no RAWX block with the phase of {s:?}"));
             assert!(block.tracking.cp_valid);
             assert_eq!(block.lock_time_s, s.carrier_lock_time_s);
+            let block_signal = signal(block.gnss_id, block.sig_id).unwrap();
+            assert!((s.carrier_wavelength_m - block_signal.wavelength_m()).abs() < 1e-12);
         }
     }
-    println!("{with_phase} of {satellites} satellite epochs with a carrier phase");
+    println!(
+        "{with_phase} of {satellites} satellite epochs with a carrier phase, {phase_only} \
+         of them without a range"
+    );
+    assert!(phase_only > 0 && phase_only < with_phase);
     assert!(
         with_phase * 10 > satellites * 9,
         "{with_phase} of {satellites}"

@@ -42,8 +42,11 @@ pub struct EpochStats {
     /// Satellites left out because the input holds two measurements of one of their
     /// signals (corrupt or forged input: which one is right cannot be known).
     pub duplicate_signals: usize,
-    /// Satellites left out for lack of a dual-frequency pair (ionosphere-free mode).
+    /// Satellites without a dual-frequency pair (ionosphere-free mode): no range of
+    /// theirs is used.
     pub single_frequency: usize,
+    /// Of those, the satellites kept for their carrier phase and rate alone.
+    pub phase_only: usize,
     /// Satellites skipped for lack of a healthy, valid ephemeris.
     pub no_ephemeris: usize,
     /// Satellites skipped for another ephemeris problem (group delay, non-finite).
@@ -70,7 +73,7 @@ pub struct BuiltEpoch {
 pub fn unfilled_observation(sat: SatId, pseudorange_m: f64) -> SatObservation {
     SatObservation {
         sat,
-        pseudorange_m,
+        pseudorange_m: Some(pseudorange_m),
         pseudorange_rate_mps: None,
         pseudorange_sigma_m: None,
         pseudorange_rate_sigma_mps: None,

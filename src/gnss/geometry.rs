@@ -481,7 +481,7 @@ mod tests {
     fn observation(r_sat: Vector3<f64>) -> SatObservation {
         SatObservation {
             sat: G01,
-            pseudorange_m: 2.2e7,
+            pseudorange_m: Some(2.2e7),
             pseudorange_rate_mps: None,
             pseudorange_sigma_m: None,
             pseudorange_rate_sigma_mps: None,

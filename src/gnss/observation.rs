@@ -59,7 +59,10 @@ impl std::fmt::Display for SatId {
 #[derive(Debug, Clone, PartialEq)]
 pub struct SatObservation {
     pub sat: SatId,
-    pub pseudorange_m: f64,
+    /// The pseudo-range (m); None for a satellite kept only for its carrier phase and
+    /// rate: one without a range of the epoch's kind (a single-frequency satellite beside
+    /// ionosphere-free ranges, whose range would bring the ionosphere back as a bias).
+    pub pseudorange_m: Option<f64>,
     pub pseudorange_rate_mps: Option<f64>,
     /// Receiver-reported 1σ of the pseudo-range (m).
     pub pseudorange_sigma_m: Option<f64>,

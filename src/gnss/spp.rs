@@ -497,7 +497,11 @@ fn evaluate(
         }
         let sat = obs.sat;
         let clock_bias_m = clocks.value_m(sat.constellation);
-        if !obs.pseudorange_m.is_finite() {
+        // A satellite kept only for its carrier phase has no range to solve with.
+        let Some(pseudorange_m) = obs.pseudorange_m else {
+            continue;
+        };
+        if !pseudorange_m.is_finite() {
             let e = GnssModelError::NonFinite {
                 sat,
                 what: "pseudo-range",
@@ -558,7 +562,7 @@ fn evaluate(
             index,
             h: Vector4::new(-los[0], -los[1], -los[2], 1.0),
             group: clocks.group(sat.constellation),
-            residual: obs.pseudorange_m - predicted,
+            residual: pseudorange_m - predicted,
             sigma: config.sigma.pseudorange_sigma_m(obs, weighting_elevation),
             elevation_rad,
             weighting_elevation_rad: weighting_elevation,
@@ -860,7 +864,7 @@ mod tests {
                 constellation: Constellation::Gps,
                 prn: 7,
             },
-            pseudorange_m: 2.2e7,
+            pseudorange_m: Some(2.2e7),
             pseudorange_rate_mps: None,
             pseudorange_sigma_m: sigma_m,
             pseudorange_rate_sigma_mps: None,

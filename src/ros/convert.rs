@@ -308,10 +308,11 @@ pub fn seconds_to_time(t_s: f64) -> Result<Time, ConvertError> {
 /// - `t_s` is `header.stamp` in seconds; the GPS time of week must lie in [0, 604800).
 /// - NaN in an optional field (rate, sigmas, C/N0, atmospheric delays) becomes `None`;
 ///   an infinite value there, or a sigma that is not positive, is an error.
-/// - Choice: the pseudo-range and the satellite's position, velocity, clock bias and
-///   drift are required (the core type cannot say "absent"): a non-finite value there
-///   rejects the whole epoch with an error naming the satellite, rather than passing a
-///   NaN into the filter.
+/// - Choice: the satellite's position, velocity, clock bias and drift are required (the
+///   core type cannot say "absent"), and so is the pseudo-range unless the satellite
+///   carries a carrier phase (a satellite kept for its phase alone, NaN range): a
+///   non-finite value there rejects the whole epoch with an error naming the satellite,
+///   rather than passing a NaN into the filter.
 /// - The Klobuchar coefficients are kept only when all eight are finite (NaN = not
 ///   broadcast; a partial set is unusable).
 /// - `gps_week` is not carried: the core needs only the time of week.
@@ -408,9 +409,15 @@ fn sat_observation(
         0.0..=MAX_SAT_CLOCK_DRIFT_S_S,
         "at most 1e-6 s/s",
     )?;
+    let carrier_phase = carrier_phase(&check, m)?;
+    let pseudorange_m = if carrier_phase.is_some() {
+        check.optional("pseudorange_m", m.pseudorange_m)?
+    } else {
+        Some(check.required("pseudorange_m", m.pseudorange_m)?)
+    };
     Ok(SatObservation {
         sat,
-        pseudorange_m: check.required("pseudorange_m", m.pseudorange_m)?,
+        pseudorange_m,
         pseudorange_rate_mps: check.optional("pseudorange_rate_mps", m.pseudorange_rate_mps)?,
         pseudorange_sigma_m: check.sigma("pseudorange_sigma_m", m.pseudorange_sigma_m)?,
         pseudorange_rate_sigma_mps: check
@@ -422,7 +429,7 @@ fn sat_observation(
         sat_clock_drift_s_s,
         iono_delay_m: check.optional("ionosphere_delay_m", m.ionosphere_delay_m)?,
         tropo_delay_m: check.optional("troposphere_delay_m", m.troposphere_delay_m)?,
-        carrier_phase: carrier_phase(&check, m)?,
+        carrier_phase,
     })
 }
 
@@ -768,11 +775,27 @@ mod tests {
     }
 
     #[test]
+    fn a_satellite_with_a_phase_may_come_without_a_range() {
+        let mut msg = epoch_msg();
+        msg.satellites[1].pseudorange_m = f64::NAN;
+        msg.satellites[1].pseudorange_sigma_m = f64::NAN;
+        let epoch = GnssEpoch::try_from(&msg).unwrap();
+        let sat = &epoch.satellites[1];
+        assert_eq!((sat.pseudorange_m, sat.pseudorange_sigma_m), (None, None));
+        assert_eq!(sat.carrier_phase.unwrap().cycles, 112_755_213.375);
+        assert_eq!(epoch.satellites[0].pseudorange_m, Some(21_456_789.125));
+        // Infinity is never "absent".
+        msg.satellites[1].pseudorange_m = f64::INFINITY;
+        assert_eq!(field_error(&msg).1, "pseudorange_m");
+    }
+
+    #[test]
     fn non_finite_required_fields_name_the_satellite() {
         let mut msg = epoch_msg();
         msg.satellites[1].constellation = SatelliteMeasurement::GALILEO;
         msg.satellites[1].prn = 12;
         msg.satellites[1].pseudorange_m = f64::NAN;
+        msg.satellites[1].carrier_phase_cycles = f64::NAN;
         assert_eq!(field_error(&msg), ("E12".to_string(), "pseudorange_m"));
         let err = GnssEpoch::try_from(&msg).unwrap_err().to_string();
         assert!(

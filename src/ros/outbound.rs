@@ -290,7 +290,7 @@ pub fn gnss_measurements(
             .map(|s| SatelliteMeasurement {
                 constellation: s.sat.constellation.code(),
                 prn: s.sat.prn,
-                pseudorange_m: s.pseudorange_m,
+                pseudorange_m: s.pseudorange_m.unwrap_or(nan),
                 pseudorange_rate_mps: s.pseudorange_rate_mps.unwrap_or(nan),
                 pseudorange_sigma_m: s.pseudorange_sigma_m.unwrap_or(nan),
                 pseudorange_rate_sigma_mps: s.pseudorange_rate_sigma_mps.unwrap_or(nan),

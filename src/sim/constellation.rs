@@ -385,7 +385,7 @@ impl GpsConstellation {
         if !(noise.pseudorange_m.is_finite() && noise.pseudorange_rate_mps.is_finite()) {
             return Err(SimError::NonFiniteInput { what: "noise" });
         }
-        obs.pseudorange_m += noise.pseudorange_m;
+        obs.pseudorange_m = obs.pseudorange_m.map(|p| p + noise.pseudorange_m);
         obs.pseudorange_rate_mps = obs
             .pseudorange_rate_mps
             .map(|r| r + noise.pseudorange_rate_mps);
@@ -413,7 +413,7 @@ impl GpsConstellation {
                     return Err(SimError::NonFiniteInput { what: "noise" });
                 }
                 satellites.push(SatObservation {
-                    pseudorange_m: obs.pseudorange_m + n.pseudorange_m,
+                    pseudorange_m: obs.pseudorange_m.map(|p| p + n.pseudorange_m),
                     pseudorange_rate_mps: obs
                         .pseudorange_rate_mps
                         .map(|r| r + n.pseudorange_rate_mps),
@@ -496,7 +496,7 @@ impl GpsConstellation {
         let c = SPEED_OF_LIGHT_M_S;
         let obs = SatObservation {
             sat: sat.id,
-            pseudorange_m: range_m + rx.clock_bias_m - c * tx.clock_bias_s + iono_m + tropo_m,
+            pseudorange_m: Some(range_m + rx.clock_bias_m - c * tx.clock_bias_s + iono_m + tropo_m),
             pseudorange_rate_mps: Some(
                 geometry.range_rate_mps + rx.clock_drift_mps - c * tx.clock_drift_s_s,
             ),
@@ -664,7 +664,7 @@ mod tests {
             let minus =
                 GpsConstellation::simulate_observation(sat, t0 - h, &truth(-h), &vacuum, &none)
                     .unwrap();
-            let fd = (plus.pseudorange_m - minus.pseudorange_m) / (2.0 * h);
+            let fd = (plus.pseudorange_m.unwrap() - minus.pseudorange_m.unwrap()) / (2.0 * h);
             let rate = obs.pseudorange_rate_mps.unwrap();
             assert!((fd - rate).abs() < 2e-5, "{}: {fd} vs {rate}", obs.sat);
         }
@@ -695,7 +695,10 @@ mod tests {
             },
         )
         .unwrap();
-        assert_eq!(noisy.pseudorange_m - clean.pseudorange_m, 1.5);
+        assert_eq!(
+            noisy.pseudorange_m.unwrap() - clean.pseudorange_m.unwrap(),
+            1.5
+        );
         assert_eq!(
             noisy.pseudorange_rate_mps.unwrap() - clean.pseudorange_rate_mps.unwrap(),
             -0.25

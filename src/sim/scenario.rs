@@ -339,7 +339,7 @@ impl Scenario {
                 segment,
             };
             if let Some(err) = sat_errors.draw(&ctx) {
-                obs.pseudorange_m += err.pseudorange_error_m;
+                obs.pseudorange_m = obs.pseudorange_m.map(|p| p + err.pseudorange_error_m);
                 obs.pseudorange_rate_mps = obs
                     .pseudorange_rate_mps
                     .map(|r| r + err.pseudorange_rate_error_mps);

@@ -373,13 +373,14 @@ pub struct SppArgs {
 fn print_convert_summary(out: &std::path::Path, s: &ConvertSummary) {
     eprintln!(
         "wrote {}: {} GNSS epochs ({:.1} satellites each; {} epochs without a usable \
-         satellite left out; {:.1} single-frequency satellites per epoch left out; \
-         Klobuchar {}), {} IMU samples, reference {:?}; UTC {:.3}..{:.3} s",
+         satellite left out; {:.1} single-frequency satellites per epoch without a range, \
+         {:.1} of them kept for their carrier phase; Klobuchar {}), {} IMU samples, reference {:?}; UTC {:.3}..{:.3} s",
         out.display(),
         s.gnss_epochs,
         s.satellites as f64 / s.gnss_epochs.max(1) as f64,
         s.empty_epochs,
         s.single_frequency as f64 / s.gnss_epochs.max(1) as f64,
+        s.phase_only as f64 / s.gnss_epochs.max(1) as f64,
         if s.klobuchar { "present" } else { "absent" },
         s.imu_samples,
         s.truth,

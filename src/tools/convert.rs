@@ -177,8 +177,10 @@ pub struct ConvertSummary {
     pub satellites: usize,
     /// RAWX epochs without a usable satellite (not written).
     pub empty_epochs: usize,
-    /// Satellite-epochs left out for lack of a dual-frequency pair (ionosphere-free).
+    /// Satellite-epochs without a dual-frequency pair (ionosphere-free): no range used.
     pub single_frequency: usize,
+    /// Of those, the satellite-epochs kept for their carrier phase and rate alone.
+    pub phase_only: usize,
     /// Whether the log had Klobuchar coefficients.
     pub klobuchar: bool,
     /// GPS − UTC the receiver reported (valid RAWX leap seconds), if it did.
@@ -380,6 +382,7 @@ fn gnss_items(
             },
         };
         summary.single_frequency += built.stats.single_frequency;
+        summary.phase_only += built.stats.phase_only;
         if built.epoch.satellites.is_empty() || !raw.rcv_tow_s.is_finite() {
             summary.empty_epochs += 1;
             continue;
@@ -432,6 +435,7 @@ fn robot_bag_items(
     }
     summary.empty_epochs = read.counts.empty_epochs as usize;
     summary.single_frequency = read.counts.satellites.single_frequency;
+    summary.phase_only = read.counts.satellites.phase_only;
     summary.receiver_leap_seconds = read
         .receiver_leap_seconds
         .and_then(|s| i8::try_from(s).ok());

@@ -103,7 +103,9 @@ pub fn noisy_epoch(
         let up = earth::rot_ecef_to_enu(receiver.p)
             * (sat.sat_pos_ecef_m - truth.pos_ecef_m).normalize();
         let scale = 1.0 / up[2].asin().max(10f64.to_radians()).sin();
-        sat.pseudorange_m += 3.0 * scale * unit.sample(rng);
+        if let Some(p) = sat.pseudorange_m.as_mut() {
+            *p += 3.0 * scale * unit.sample(rng);
+        }
         if let Some(r) = sat.pseudorange_rate_mps.as_mut() {
             *r += 0.1 * scale * unit.sample(rng);
         }

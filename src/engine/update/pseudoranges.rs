@@ -144,14 +144,17 @@ impl MeasurementModel for Pseudoranges<'_> {
                             observable,
                         });
                     };
-                    push(
-                        Observable::Pseudorange,
-                        geo.pseudorange_row(&pred.los_ecef),
-                        obs.pseudorange_m,
-                        pred.pseudorange_m,
-                        sigmas.pseudorange_sigma_m(obs, el),
-                        slow_sigmas.pseudorange_sigma_m(obs, el),
-                    );
+                    // A satellite kept for its carrier phase alone gives its rate only.
+                    if let Some(pseudorange_m) = obs.pseudorange_m {
+                        push(
+                            Observable::Pseudorange,
+                            geo.pseudorange_row(&pred.los_ecef),
+                            pseudorange_m,
+                            pred.pseudorange_m,
+                            sigmas.pseudorange_sigma_m(obs, el),
+                            slow_sigmas.pseudorange_sigma_m(obs, el),
+                        );
+                    }
                     if let (true, Some(rate)) =
                         (config.gnss.use_pseudorange_rate, obs.pseudorange_rate_mps)
                     {
@@ -324,7 +327,7 @@ pub(super) fn screen(
     if !config.gnss.constellations.contains(&obs.sat.constellation) {
         return Err(SatRejection::ConstellationDisabled);
     }
-    if !obs.pseudorange_m.is_finite() {
+    if obs.pseudorange_m.is_some_and(|p| !p.is_finite()) {
         return Err(SatRejection::NotANumber);
     }
     if config.gnss.cn0_mask_dbhz > 0.0 {

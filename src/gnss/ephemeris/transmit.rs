@@ -105,7 +105,8 @@ pub fn state_at_transmission(
 /// that time, velocity, clock bias with relativistic term and the measurement's group
 /// delay (one signal's, or a combination's, see [`RangingCode`]),
 /// clock drift) from the ephemeris `store` selects for `obs.sat` at the receive time
-/// `t_rx`, using `obs.pseudorange_m` for the travel time.
+/// `t_rx`, using `obs.pseudorange_m` for the travel time (an observation without one is
+/// refused as non-finite).
 pub fn fill_satellite_fields(
     obs: &mut SatObservation,
     store: &EphemerisStore,
@@ -118,7 +119,8 @@ pub fn fill_satellite_fields(
         week: t_rx.week,
         tow_s: t_rx.tow_s,
     })?;
-    let tx = state_at_transmission(eph, code, t_rx, obs.pseudorange_m)?;
+    let pseudorange_m = obs.pseudorange_m.unwrap_or(f64::NAN);
+    let tx = state_at_transmission(eph, code, t_rx, pseudorange_m)?;
     obs.sat_pos_ecef_m = tx.state.pos_ecef_m;
     obs.sat_vel_ecef_mps = tx.state.vel_ecef_mps;
     obs.sat_clock_bias_s = tx.clock_bias_s;

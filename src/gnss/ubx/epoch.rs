@@ -3,10 +3,14 @@
 //!
 //! Choices (beyond the shared ones of [`crate::gnss::epoch_build`]):
 //! - [`IonosphereMode::IonoFree`]: the ionosphere-free combination of the first pair of
-//!   [`iono_free_pairs`] with both pseudo-ranges valid, σ propagated from both prStdev;
-//!   satellites without one are left out (counted as `single_frequency`). The rate is the
-//!   first signal's Doppler: the ionosphere's rate of change (millimetres per second) is
-//!   left in it. The other modes use one signal per satellite
+//!   [`iono_free_pairs`] with both pseudo-ranges valid, σ propagated from both prStdev.
+//!   A satellite without one (counted as `single_frequency`) brings no range, which
+//!   would carry the ionosphere back as a bias, but when its preferred single signal has
+//!   a valid carrier phase it is kept for that phase and its Doppler (counted as
+//!   `phase_only`; no pseudo-range): the time difference of a phase and a Doppler change
+//!   with the ionosphere by millimetres (per second), as the rates of the pairs do. The
+//!   rate is the first signal's Doppler: the ionosphere's rate of change (millimetres per
+//!   second) is left in it. The other modes use one signal per satellite
 //!   ([`crate::gnss::epoch_build::preferred_signals`]).
 //! - Receive time: the RAWX receiver time (week, rcvTow) as GPST, uncorrected for the
 //!   receiver clock (see [`crate::gnss::ephemeris::state_at_transmission`]).
@@ -64,19 +68,23 @@ pub fn build_epoch_with(
             stats.duplicate_signals += 1;
             continue;
         }
+        let single = || choose(raw, sat).map(|(sig, m)| (RangingCode::Single(sig), m, None));
         let chosen = match mode {
-            IonosphereMode::IonoFree => choose_pair(raw, sat),
-            IonosphereMode::Broadcast | IonosphereMode::None => {
-                choose(raw, sat).map(|(sig, m)| (RangingCode::Single(sig), m, None))
-            }
+            IonosphereMode::IonoFree => choose_pair(raw, sat).or_else(|| {
+                // A satellite that single-frequency mode would use.
+                let (code, m, second) = single()?;
+                if store.select(sat, &receive_time).is_none() {
+                    stats.no_ephemeris += 1;
+                    return None;
+                }
+                stats.single_frequency += 1;
+                m.tracking.cp_valid.then_some((code, m, second))
+            }),
+            IonosphereMode::Broadcast | IonosphereMode::None => single(),
         };
         let Some((code, m, second)) = chosen else {
-            // Ionosphere-free mode: a satellite that single-frequency mode would use.
-            let single = mode == IonosphereMode::IonoFree && choose(raw, sat).is_some();
-            match (single, store.select(sat, &receive_time).is_some()) {
-                (true, true) => stats.single_frequency += 1,
-                (true, false) => stats.no_ephemeris += 1,
-                (false, _) => stats.unsupported += 1,
+            if mode != IonosphereMode::IonoFree || choose(raw, sat).is_none() {
+                stats.unsupported += 1;
             }
             continue;
         };
@@ -85,7 +93,18 @@ pub fn build_epoch_with(
             None => stats.unsupported += 1,
         }
     }
-    complete_epoch(receive_time, candidates, store, klobuchar, stats)
+    let mut built = complete_epoch(receive_time, candidates, store, klobuchar, stats);
+    if mode == IonosphereMode::IonoFree {
+        // The single signals' ranges timed their satellites' transmission; now drop them.
+        for (obs, code) in built.epoch.satellites.iter_mut().zip(&built.signals) {
+            if matches!(code, RangingCode::Single(_)) {
+                obs.pseudorange_m = None;
+                obs.pseudorange_sigma_m = None;
+                built.stats.phase_only += 1;
+            }
+        }
+    }
+    built
 }
 
 /// The satellites (sorted) of which `raw` holds two blocks of one signal.

@@ -60,6 +60,7 @@ impl UbxAdapterCounts {
         t.unsupported += s.unsupported;
         t.duplicate_signals += s.duplicate_signals;
         t.single_frequency += s.single_frequency;
+        t.phase_only += s.phase_only;
         t.no_ephemeris += s.no_ephemeris;
         t.ephemeris_errors += s.ephemeris_errors;
         t.used += s.used;
@@ -93,6 +94,7 @@ impl UbxAdapterCounts {
             ("satellite_epochs_used", s.used),
             ("satellite_epochs_no_ephemeris", s.no_ephemeris),
             ("satellite_epochs_single_frequency", s.single_frequency),
+            ("satellite_epochs_phase_only", s.phase_only),
             ("satellite_epochs_duplicate_signals", s.duplicate_signals),
             ("satellite_epochs_unsupported", s.unsupported),
             ("satellite_epochs_ephemeris_errors", s.ephemeris_errors),
