@@ -11,7 +11,7 @@
 //! 3. Position, velocity and clock come from an iterated least-squares single-point
 //!    solution (tightly coupled) or the receiver's fix (loosely coupled).
 //! 4. The heading is `init.heading_deg` (a compass heading) when given; otherwise a
-//!    dual-antenna pair's heading no older than [`ANTENNA_HEADING_AGE_S`] (with its σ: the
+//!    dual-antenna pair's heading no older than [`alignment::ANTENNA_HEADING_AGE_S`] (with its σ: the
 //!    heading at rest); otherwise, levelled at rest, the gyrocompass's
 //!    ([`super::gyrocompass`]: the earth rate's direction in the levelling's mean rate,
 //!    with its σ; only when that σ is below [`super::gyrocompass::MAX_SIGMA_RAD`], which
@@ -28,30 +28,28 @@
 //!    the change of speed; sideways and up: the rate times the speed, the centripetal
 //!    acceleration of a turn); gyro bias zero with the class's σ (`imu.gyro_bias_deg_per_h`).
 //!    The covariance covers the alignment's errors: the course's own uncertainty and
-//!    [`COURSE_SIGMA_RAD`] in the heading, the unknown acceleration in roll and pitch.
+//!    [`alignment::COURSE_SIGMA_RAD`] in the heading, the unknown acceleration in roll and pitch.
 //!    A heading σ above [`super::heading_bank::BANK_ABOVE_RAD`] is resolved by the engine's bank of
 //!    heading hypotheses ([`super::heading_bank`]).
 
 use nalgebra::{Matrix2, Matrix3, UnitQuaternion, Vector2, Vector3};
 
-use crate::config::{Config, Coupling};
+use crate::config::Config;
 use crate::earth::{self, Llh};
 use crate::gnss::spp::{self, SppConfig};
 use crate::gnss::GnssEpoch;
-use crate::ins::error_state::{
-    StateMatrix, ACC_BIAS, ACC_SCALE, CLOCK_BIAS, CLOCK_DRIFT, DP, DV, GYRO_BIAS, GYRO_GM,
-    GYRO_SCALE, PHI, WHEEL_SCALE,
-};
+use crate::ins::error_state::{StateMatrix, CLOCK_BIAS, CLOCK_DRIFT};
 use crate::ins::{ImuSample, NavState};
 
 use super::fix_track::FixTrack;
-use super::gyrocompass;
 use super::standstill::MotionStatistics;
 use super::update::{sigma_model, GnssFix};
 
-/// 1-sigma of an acceleration along the body's forward axis that no GNSS speed difference
-/// measures (m/s²). Choice: a car's brisk acceleration or braking.
-const UNKNOWN_ACCELERATION_M_S2: f64 = 1.0;
+mod alignment;
+mod initial_state;
+
+use alignment::enu_yaw_of_heading;
+
 /// Longest interval between two GNSS speeds whose difference gives the forward
 /// acceleration of an alignment in motion, and the age up to which a GNSS speed counts in
 /// the levelling's rest test (s).
@@ -61,12 +59,6 @@ const SPEED_AGE_S: f64 = 2.0;
 /// a receiver velocity takes a heading. Choice: 3, so that one fix pulled by noise or an
 /// outlier does not set the heading.
 const MOTION_EPOCHS: usize = 3;
-/// 1-sigma of the body's forward axis against the course (rad): side-slip and the
-/// mounting's yaw. Choice: 3°, a car's side-slip in a brisk turn.
-const COURSE_SIGMA_RAD: f64 = 3.0 * std::f64::consts::PI / 180.0;
-/// Oldest dual-antenna heading a start takes (s). Choice: 1 s, a few of the pair's epochs;
-/// the body turns little in that time while levelled or parked.
-const ANTENNA_HEADING_AGE_S: f64 = 1.0;
 /// A GNSS speed above this denies the levelling's rest (m/s). Choice: 0.5 m/s, above the
 /// speed noise of a single-point velocity and below a walking pace.
 const REST_SPEED_MAX_MPS: f64 = 0.5;
@@ -558,289 +550,6 @@ impl Initializer {
         let position_var_m2 = fit.position_var_m2 + (0.5 * shortfall_m).powi(2);
         Some((velocity, position, position_var_m2))
     }
-
-    /// The levelled attitude turned to the heading found, with the configured 1-sigmas; a
-    /// heading from the `course` of a GNSS velocity has at least the course's own
-    /// uncertainty and [`COURSE_SIGMA_RAD`]; one with its own σ (a dual antenna, the
-    /// gyrocompass) has that.
-    fn levelled(
-        q_nb: UnitQuaternion<f64>,
-        course: Option<GnssVelocity>,
-        heading: &StartHeading,
-        config: &Config,
-    ) -> Alignment {
-        let i = &config.init;
-        let heading_sigma = heading.sigma_rad.unwrap_or_else(|| {
-            course.map_or(i.heading_sigma_rad, |v| {
-                i.heading_sigma_rad
-                    .max(v.course_sigma_rad().hypot(COURSE_SIGMA_RAD))
-            })
-        });
-        // The velocity's own uncertainty where it exceeds the configured σ.
-        let velocity_sigma_mps = course.map_or(i.velocity_sigma_mps, |v| {
-            let own_var = 0.5 * v.cov_h_m2_s2.trace() + v.extrapolation_sigma_mps.powi(2);
-            i.velocity_sigma_mps.max(own_var.max(0.0).sqrt())
-        });
-        Alignment {
-            q_nb,
-            sigma_rad: [i.attitude_sigma_rad, i.attitude_sigma_rad, heading_sigma],
-            velocity_sigma_mps,
-            gyrocompass: heading.gyrocompass,
-        }
-    }
-
-    /// Roll, pitch and heading of a moving platform from the newest GNSS velocity and the
-    /// `recent` IMU samples (see the module documentation); None while not moving.
-    fn align_in_motion(
-        &self,
-        previous: Option<GnssVelocity>,
-        recent: &MotionStatistics,
-        config: &Config,
-    ) -> Option<Alignment> {
-        let v = self.velocity.filter(|v| v.moving(config))?;
-        if recent.count() < 2 {
-            return None;
-        }
-        let speed = v.v_enu_mps.norm();
-        let speed_sigma = v.cov_h_m2_s2.trace().max(0.0).sqrt();
-        // The forward acceleration from the previous GNSS speed, when that is close enough
-        // in time and precise enough to beat the unknown acceleration.
-        let (accel, accel_sigma) = previous
-            .filter(|p| p.confirmed && p.t_s < v.t_s && v.t_s - p.t_s <= SPEED_AGE_S)
-            .map(|p| {
-                let dt = v.t_s - p.t_s;
-                let sigma = (v.cov_h_m2_s2.trace() + p.cov_h_m2_s2.trace())
-                    .max(0.0)
-                    .sqrt()
-                    / dt;
-                ((speed - p.v_enu_mps.norm()) / dt, sigma)
-            })
-            .filter(|(_, sigma)| *sigma < UNKNOWN_ACCELERATION_M_S2)
-            .unwrap_or((0.0, UNKNOWN_ACCELERATION_M_S2));
-        // The body's acceleration with its velocity along x: d/dt (s, 0, 0) + ω × (s, 0, 0).
-        let w = recent.mean_w();
-        let a_b = Vector3::new(accel, w[2] * speed, -w[1] * speed);
-        let up = recent.mean_f() - a_b;
-        let roll = up[1].atan2(up[2]);
-        let pitch = (-up[0]).atan2(up[1].hypot(up[2]));
-        let yaw = match config.init.heading_rad {
-            Some(heading) => enu_yaw_of_heading(heading),
-            None => v.v_enu_mps[1].atan2(v.v_enu_mps[0]),
-        };
-        let g = up.norm().max(1.0);
-        let i = &config.init;
-        let sideways = self.turn_on_gyro_bias_sigma_rad_s(config) * speed;
-        let heading_sigma = match config.init.heading_rad {
-            Some(_) => i.heading_sigma_rad,
-            None => v.course_sigma_rad().hypot(COURSE_SIGMA_RAD),
-        };
-        Some(Alignment {
-            q_nb: UnitQuaternion::from_euler_angles(roll, pitch, yaw),
-            sigma_rad: [
-                i.attitude_sigma_rad.hypot(sideways / g),
-                i.attitude_sigma_rad.hypot(accel_sigma / g),
-                heading_sigma,
-            ],
-            velocity_sigma_mps: i.velocity_sigma_mps.max(speed_sigma),
-            gyrocompass: false,
-        })
-    }
-
-    /// The heading of a start at `t_s` at latitude `lat_rad` (see the module
-    /// documentation); None while unknown.
-    fn heading(
-        &self,
-        t_s: f64,
-        v_enu: Option<&Vector3<f64>>,
-        lat_rad: f64,
-        config: &Config,
-    ) -> Option<StartHeading> {
-        if let Some(heading) = config.init.heading_rad {
-            return Some(StartHeading {
-                yaw_rad: enu_yaw_of_heading(heading),
-                from_motion: false,
-                sigma_rad: None,
-                gyrocompass: false,
-            });
-        }
-        if let Some(a) = self
-            .antenna_heading
-            .filter(|a| (t_s - a.t_s).abs() <= ANTENNA_HEADING_AGE_S)
-        {
-            return Some(StartHeading {
-                yaw_rad: enu_yaw_of_heading(a.heading_rad),
-                from_motion: false,
-                sigma_rad: Some(a.sigma_rad),
-                gyrocompass: false,
-            });
-        }
-        // The levelled attitude's heading, carried to now by the turn the gyros have seen
-        // since the levelling.
-        let compass = self.attitude.as_ref().and_then(|attitude| {
-            let rest = attitude.at_rest?;
-            let found = gyrocompass::gyrocompass(
-                &rest.q_level,
-                &rest.mean_w_rad_s,
-                rest.window_s,
-                lat_rad,
-                config,
-            )?;
-            let turned_rad = attitude.q_nb.euler_angles().2 - rest.q_level.euler_angles().2;
-            Some(StartHeading {
-                yaw_rad: found.yaw_rad + turned_rad,
-                from_motion: false,
-                sigma_rad: Some(found.sigma_rad),
-                gyrocompass: true,
-            })
-        });
-        if compass.is_some() {
-            return compass;
-        }
-        let v = v_enu?;
-        (v[0].hypot(v[1]) >= config.init.heading_min_speed_mps).then(|| StartHeading {
-            yaw_rad: v[1].atan2(v[0]),
-            from_motion: true,
-            sigma_rad: None,
-            gyrocompass: false,
-        })
-    }
-
-    /// The attitude at the levelling turned to the start's yaw `q_nb` (by the yaw found
-    /// since), and the mean rate at rest; None without a levelling at rest.
-    fn levelled_at_rest(
-        &self,
-        q_nb: &UnitQuaternion<f64>,
-    ) -> Option<(UnitQuaternion<f64>, Vector3<f64>)> {
-        let attitude = self.attitude.as_ref()?;
-        let rest = attitude.at_rest?;
-        let yaw_offset = q_nb.euler_angles().2 - attitude.q_nb.euler_angles().2;
-        let q_rest = UnitQuaternion::from_euler_angles(0.0, 0.0, yaw_offset) * rest.q_level;
-        Some((q_rest, rest.mean_w_rad_s))
-    }
-
-    fn initial_state(
-        &self,
-        t_s: f64,
-        antenna: &Llh,
-        v_enu: Vector3<f64>,
-        alignment: &Alignment,
-        config: &Config,
-        position_var_m2: f64,
-    ) -> InitialState {
-        let q_nb = alignment.q_nb;
-        // The solution is the antenna's: move it to the IMU by the lever arm.
-        let lever_n = q_nb * config.mounting.lever_arm_b_m;
-        let imu_ecef =
-            earth::llh_to_ecef(antenna) - earth::rot_ecef_to_enu(antenna).transpose() * lever_n;
-        let p = earth::ecef_to_llh(&imu_ecef).unwrap_or(*antenna);
-        let nav = NavState {
-            t_s,
-            p,
-            v_n: v_enu,
-            q_nb,
-        };
-        let mut cov = StateMatrix::zeros();
-        let i = &config.init;
-        let set3 = |cov: &mut StateMatrix, start: usize, v: [f64; 3]| {
-            for (k, value) in v.iter().enumerate() {
-                cov[(start + k, start + k)] = *value;
-            }
-        };
-        set3(&mut cov, PHI, alignment.sigma_rad.map(|s| s.powi(2)));
-        let vel = alignment.velocity_sigma_mps.powi(2);
-        set3(&mut cov, DV, [vel, vel, vel]);
-        let pos = i.position_sigma_m.powi(2).max(position_var_m2);
-        let (north, east) = earth::metres_per_radian(&p);
-        set3(
-            &mut cov,
-            DP,
-            [pos / (north * north), pos / (east * east), pos],
-        );
-        // Choice: a bias measured at rest (the levelling window's mean rate less the earth
-        // rate) holds the rate noise's mean over the window and the in-run drift, σ_m; it
-        // is weighed, per axis, against the class's turn-on prior (zero, σ_p): the start
-        // keeps σ_p²/(σ_p² + σ_m²) of it, with σ² = σ_p² σ_m²/(σ_p² + σ_m²). Taking all
-        // of it with min(σ_p, σ_m), as before, was over-confident where the window is
-        // short against the rate noise: a claimed 0.5 °/h for an error of 0.88 °/h with
-        // the defaults' 1 s, 0.01 °/h for 0.057 °/h with navigation grade over 10 s.
-        let levelled_s = self
-            .attitude
-            .as_ref()
-            .and_then(|a| a.at_rest.map(|_| config.init.leveling_duration_s));
-        let turn_on_sigma_rad_s = self.turn_on_gyro_bias_sigma_rad_s(config);
-        let (gb, measured_weight) = levelled_s.map_or((turn_on_sigma_rad_s, 0.0), |t| {
-            let measured_var = config.imu.gyro_arw_rad_per_sqrt_s.powi(2) / t
-                + config.imu.gyro_markov_sigma_rad_s.powi(2);
-            let prior_var = turn_on_sigma_rad_s.powi(2);
-            let weight = prior_var / (prior_var + measured_var);
-            ((weight * measured_var).sqrt(), weight)
-        });
-        let gb = gb.powi(2);
-        set3(&mut cov, GYRO_BIAS, [gb, gb, gb]);
-        let q_rest = self.levelled_at_rest(&q_nb);
-        if let Some((q_rest, _)) = q_rest.filter(|_| alignment.gyrocompass) {
-            // Choice: after a gyrocompass the horizontal bias keeps the class's turn-on σ
-            // (resolved in the levelled frame): its part across north is the heading's
-            // error (inseparable at rest, see [`super::gyrocompass`]), and its part along
-            // north, which the mean rate's magnitude less Ω cos L measures, is left to the
-            // filter, since over a few seconds that measurement (the rate noise's mean) is
-            // coarser than a navigation-grade class's σ. The vertical one is as above.
-            let horizontal = turn_on_sigma_rad_s.powi(2);
-            let c_nb = q_rest.to_rotation_matrix().into_inner();
-            let p_n = Matrix3::from_diagonal(&Vector3::new(horizontal, horizontal, gb));
-            cov.fixed_view_mut::<3, 3>(GYRO_BIAS, GYRO_BIAS)
-                .copy_from(&(c_nb.transpose() * p_n * c_nb));
-        }
-        let gm = config.imu.gyro_markov_sigma_rad_s.powi(2);
-        set3(&mut cov, GYRO_GM, [gm, gm, gm]);
-        let ab = config.imu.accel_bias_sigma_m_s2.powi(2);
-        set3(&mut cov, ACC_BIAS, [ab, ab, ab]);
-        // Loosely coupled the clock is inert (`super::process_noise`).
-        if config.filter.coupling == Coupling::Tight {
-            cov[(CLOCK_BIAS, CLOCK_BIAS)] = i.clock_bias_sigma_m.powi(2);
-            cov[(CLOCK_DRIFT, CLOCK_DRIFT)] = i.clock_drift_sigma_mps.powi(2);
-        }
-        // The optional scale factors: inert (zero variance) when off.
-        if config.wheel_odometry.scale_factor_state {
-            cov[(WHEEL_SCALE, WHEEL_SCALE)] = config.wheel_odometry.scale_factor_sigma.powi(2);
-        }
-        if config.imu.scale_factor_states {
-            let (g, a) = (
-                config.imu.gyro_scale_factor_sigma.powi(2),
-                config.imu.accel_scale_factor_sigma.powi(2),
-            );
-            set3(&mut cov, GYRO_SCALE, [g, g, g]);
-            set3(&mut cov, ACC_SCALE, [a, a, a]);
-        }
-        // The bias at rest is the mean rate less the earth rate seen in the body frame,
-        // which needs the heading: the levelled attitude turned by the yaw found since
-        // (after a gyrocompass only its vertical part: the horizontal one is zero, above),
-        // weighed against the prior as above. An alignment in motion has no bias (zero,
-        // with the class's σ above).
-        let gyro_bias_rad_s = match (&self.attitude, q_rest) {
-            (None, _) => Vector3::zeros(),
-            (Some(attitude), None) => attitude.gyro_bias_rad_s,
-            (Some(_), Some((q_rest, w_rest))) => {
-                let earth_n = earth::earth_rate_enu_rad_s(p.lat_rad);
-                let measured = if alignment.gyrocompass {
-                    let vertical = (q_rest * w_rest)[2] - earth_n[2];
-                    q_rest.inverse() * Vector3::new(0.0, 0.0, vertical)
-                } else {
-                    w_rest - q_rest.inverse() * earth_n
-                };
-                measured * measured_weight
-            }
-        };
-        InitialState {
-            nav,
-            gyro_bias_rad_s,
-            clock_bias_m: 0.0,
-            clock_drift_mps: 0.0,
-            p: cov,
-            heading_from_motion: false,
-            heading_sigma_rad: alignment.sigma_rad[2],
-        }
-    }
 }
 
 /// Only the satellites of the enabled constellations.
@@ -854,11 +563,6 @@ pub(super) fn filter_constellations(epoch: &GnssEpoch, config: &Config) -> GnssE
             .collect(),
         ..epoch.clone()
     }
-}
-
-/// ENU yaw (from East towards North) of a compass heading (from North towards East).
-fn enu_yaw_of_heading(heading_rad: f64) -> f64 {
-    std::f64::consts::FRAC_PI_2 - heading_rad
 }
 
 /// The same roll and pitch with a new yaw (ENU, from East towards North).
