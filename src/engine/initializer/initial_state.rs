@@ -60,10 +60,11 @@ impl Initializer {
         // of it with min(σ_p, σ_m), as before, was over-confident where the window is
         // short against the rate noise: a claimed 0.5 °/h for an error of 0.88 °/h with
         // the defaults' 1 s, 0.01 °/h for 0.057 °/h with navigation grade over 10 s.
+        // The window's length is the one measured, which the gyrocompass uses too.
         let levelled_s = self
             .attitude
             .as_ref()
-            .and_then(|a| a.at_rest.map(|_| config.init.leveling_duration_s));
+            .and_then(|a| a.at_rest.map(|rest| rest.window_s));
         let turn_on_sigma_rad_s = self.turn_on_gyro_bias_sigma_rad_s(config);
         let (gb, measured_weight) = levelled_s.map_or((turn_on_sigma_rad_s, 0.0), |t| {
             let measured_var = config.imu.gyro_arw_rad_per_sqrt_s.powi(2) / t
