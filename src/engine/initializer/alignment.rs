@@ -8,7 +8,7 @@ use crate::config::Config;
 
 use super::super::gyrocompass;
 use super::super::standstill::MotionStatistics;
-use super::{Alignment, GnssVelocity, Initializer, StartHeading, SPEED_AGE_S};
+use super::{enu_yaw_of_heading, Alignment, GnssVelocity, Initializer, StartHeading, SPEED_AGE_S};
 
 /// 1-sigma of an acceleration along the body's forward axis that no GNSS speed difference
 /// measures (m/s²). Choice: a car's brisk acceleration or braking.
@@ -179,9 +179,4 @@ impl Initializer {
         let q_rest = UnitQuaternion::from_euler_angles(0.0, 0.0, yaw_offset) * rest.q_level;
         Some((q_rest, rest.mean_w_rad_s))
     }
-}
-
-/// ENU yaw (from East towards North) of a compass heading (from North towards East).
-pub(super) fn enu_yaw_of_heading(heading_rad: f64) -> f64 {
-    std::f64::consts::FRAC_PI_2 - heading_rad
 }

@@ -48,8 +48,6 @@ use super::update::{sigma_model, GnssFix};
 mod alignment;
 mod initial_state;
 
-use alignment::enu_yaw_of_heading;
-
 /// Longest interval between two GNSS speeds whose difference gives the forward
 /// acceleration of an alignment in motion, and the age up to which a GNSS speed counts in
 /// the levelling's rest test (s).
@@ -563,6 +561,11 @@ pub(super) fn filter_constellations(epoch: &GnssEpoch, config: &Config) -> GnssE
             .collect(),
         ..epoch.clone()
     }
+}
+
+/// ENU yaw (from East towards North) of a compass heading (from North towards East).
+fn enu_yaw_of_heading(heading_rad: f64) -> f64 {
+    std::f64::consts::FRAC_PI_2 - heading_rad
 }
 
 /// The same roll and pitch with a new yaw (ENU, from East towards North).
