@@ -20,6 +20,7 @@ use super::compare::{
 use super::plots::{write_plots, FilterRun};
 use super::progress::Progress;
 use super::replay::{self, ReplayOptions, TruthSource};
+use super::scoring::SessionReport;
 use super::simulate::{self, TRUTH_TOPIC};
 use super::start_blocker::start_blocker;
 
@@ -93,6 +94,10 @@ pub enum Command {
         /// solution quality in a converted bag: rtk_fixed, rtk_float).
         #[arg(long)]
         by_environment: bool,
+        /// Score each variant only from this many seconds after its first scored solution
+        /// (its start), leaving its convergence out of the tables (not of the figures).
+        #[arg(long, default_value_t = 0.0)]
+        scored_after_start_s: f64,
         /// How the results are printed: an aligned table, JSON or CSV.
         #[arg(long, value_enum, default_value_t = Format::Table)]
         format: Format,
@@ -254,12 +259,30 @@ pub fn run(command: Command) -> Result<(), String> {
             params_dir,
             params,
             by_environment,
+            scored_after_start_s,
             format,
             plots,
         } => {
+            if !(scored_after_start_s >= 0.0 && scored_after_start_s.is_finite()) {
+                return Err(format!(
+                    "--scored-after-start-s {scored_after_start_s}: must be a finite number of \
+                     seconds, 0 or more"
+                ));
+            }
             let configs = variant_configs(&filters, params_dir.as_deref(), &params)?;
             let runs = compare_bag(&bag, &configs, TRUTH_TOPIC)?;
-            let rows: Vec<ComparisonRow> = runs.iter().map(|(row, _)| row.clone()).collect();
+            let scored_from = |report: &SessionReport| {
+                report
+                    .first_scored_t_s()
+                    .map_or(f64::NEG_INFINITY, |t| t + scored_after_start_s)
+            };
+            let rows: Vec<ComparisonRow> = runs
+                .iter()
+                .map(|(row, report)| {
+                    let summary = report.summary(scored_from(report));
+                    ComparisonRow::new(&row.filter, &summary, row.runtime_s)
+                })
+                .collect();
             print!("{}", render(&rows, format)?);
             if by_environment {
                 let rows: Vec<EnvironmentRow> = runs
@@ -267,7 +290,7 @@ pub fn run(command: Command) -> Result<(), String> {
                     .flat_map(|(row, report)| {
                         EnvironmentRow::rows(
                             &row.filter,
-                            &report.summary_by_environment(f64::NEG_INFINITY),
+                            &report.summary_by_environment(scored_from(report)),
                         )
                     })
                     .collect();

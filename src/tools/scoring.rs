@@ -52,6 +52,12 @@ impl SessionReport {
         self.errors.into_iter().map(|(_, e)| e).collect()
     }
 
+    /// The time of the first scored solution (the filter's start, as far as the reference
+    /// reaches), if any.
+    pub fn first_scored_t_s(&self) -> Option<f64> {
+        self.errors.iter().map(|(_, e)| e.t_s).reduce(f64::min)
+    }
+
     /// Summary over all scored solutions at or after `from_t_s`.
     pub fn summary(&self, from_t_s: f64) -> ErrorSummary {
         let errors: Vec<SolutionError> = self
