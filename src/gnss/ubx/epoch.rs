@@ -70,22 +70,28 @@ pub fn build_epoch_with(
         }
         let single = || choose(raw, sat).map(|(sig, m)| (RangingCode::Single(sig), m, None));
         let chosen = match mode {
-            IonosphereMode::IonoFree => choose_pair(raw, sat).or_else(|| {
-                // A satellite that single-frequency mode would use.
-                let (code, m, second) = single()?;
-                if store.select(sat, &receive_time).is_none() {
-                    stats.no_ephemeris += 1;
-                    return None;
-                }
-                stats.single_frequency += 1;
-                m.tracking.cp_valid.then_some((code, m, second))
-            }),
+            IonosphereMode::IonoFree => match choose_pair(raw, sat) {
+                Some(pair) => Some(pair),
+                // A satellite that single-frequency mode would use: its phase alone.
+                None => match single() {
+                    Some(_) if store.select(sat, &receive_time).is_none() => {
+                        stats.no_ephemeris += 1;
+                        continue;
+                    }
+                    Some(one) => {
+                        stats.single_frequency += 1;
+                        if !one.1.tracking.cp_valid {
+                            continue;
+                        }
+                        Some(one)
+                    }
+                    None => None,
+                },
+            },
             IonosphereMode::Broadcast | IonosphereMode::None => single(),
         };
         let Some((code, m, second)) = chosen else {
-            if mode != IonosphereMode::IonoFree || choose(raw, sat).is_none() {
-                stats.unsupported += 1;
-            }
+            stats.unsupported += 1;
             continue;
         };
         match observation(sat, code, m, second, mode, raw.clock_reset) {
