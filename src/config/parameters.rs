@@ -568,7 +568,9 @@ parameter_table! {
             si Scale::to("rad", RAD_PER_DEG);
         /// Initial 1-sigma of each velocity component.
         velocity_sigma_mps: f64 = 0.5, unit "m/s", range SIGMA, at_start;
-        /// Initial 1-sigma of each position component.
+        /// Least initial 1-sigma of the position: of each component of the receiver's fix
+        /// a loosely-coupled start takes, and of the components' mean (the root of their
+        /// mean variance) of each single-point solution a tightly-coupled start combines.
         position_sigma_m: f64 = 5.0, unit "m", range SIGMA, at_start;
         /// Initial 1-sigma of the receiver clock bias c*dt_u.
         clock_bias_sigma_m: f64 = 30.0, unit "m", range SIGMA, at_start;

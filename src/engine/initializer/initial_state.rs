@@ -22,7 +22,7 @@ impl Initializer {
         v_enu: Vector3<f64>,
         alignment: &Alignment,
         config: &Config,
-        position_var_m2: f64,
+        position_var_enu_m2: Vector3<f64>,
     ) -> InitialState {
         let q_nb = alignment.q_nb;
         // The solution is the antenna's: move it to the IMU by the lever arm.
@@ -46,12 +46,12 @@ impl Initializer {
         set3(&mut cov, PHI, alignment.sigma_rad.map(|s| s.powi(2)));
         let vel = alignment.velocity_sigma_mps.powi(2);
         set3(&mut cov, DV, [vel, vel, vel]);
-        let pos = i.position_sigma_m.powi(2).max(position_var_m2);
+        let [east_m2, north_m2, up_m2] = position_var_enu_m2.into();
         let (north, east) = earth::metres_per_radian(&p);
         set3(
             &mut cov,
             DP,
-            [pos / (north * north), pos / (east * east), pos],
+            [north_m2 / (north * north), east_m2 / (east * east), up_m2],
         );
         // Choice: a bias measured at rest (the levelling window's mean rate less the earth
         // rate) holds the rate noise's mean over the window and the in-run drift, σ_m; it

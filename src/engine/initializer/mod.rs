@@ -8,8 +8,10 @@
 //!    window gives no attitude and no gyro bias (a turn's rate is no bias); the next window
 //!    is tried.
 //! 2. Until the filter starts, the levelled attitude is carried forward by the gyros alone.
-//! 3. Position, velocity and clock come from an iterated least-squares single-point
-//!    solution (tightly coupled) or the receiver's fix (loosely coupled).
+//! 3. Velocity and clock come from an iterated least-squares single-point solution
+//!    (tightly coupled) or the receiver's fix (loosely coupled); the position from every
+//!    single-point solution since the start-up began, combined ([`position_track`]), or
+//!    the receiver's fix.
 //! 4. The heading is `init.heading_deg` (a compass heading) when given; otherwise a
 //!    dual-antenna pair's heading no older than [`alignment::ANTENNA_HEADING_AGE_S`] (with its σ: the
 //!    heading at rest); otherwise, levelled at rest, the gyrocompass's
@@ -47,6 +49,9 @@ use super::update::{sigma_model, GnssFix};
 
 mod alignment;
 mod initial_state;
+mod position_track;
+
+use position_track::PositionTrack;
 
 /// Longest interval between two GNSS speeds whose difference gives the forward
 /// acceleration of an alignment in motion, and the age up to which a GNSS speed counts in
@@ -57,8 +62,9 @@ const SPEED_AGE_S: f64 = 2.0;
 /// a receiver velocity takes a heading. Choice: 3, so that one fix pulled by noise or an
 /// outlier does not set the heading.
 const MOTION_EPOCHS: usize = 3;
-/// A GNSS speed above this denies the levelling's rest (m/s). Choice: 0.5 m/s, above the
-/// speed noise of a single-point velocity and below a walking pace.
+/// A GNSS speed above this denies the levelling's rest, and the start position track's
+/// when significant (m/s). Choice: 0.5 m/s, above the speed noise of a single-point
+/// velocity and below a walking pace.
 const REST_SPEED_MAX_MPS: f64 = 0.5;
 /// Confidence of the test that a GNSS velocity differs from zero. Choice: 0.999, so that
 /// fix noise at a standstill passes it once in a thousand fixes, and [`MOTION_EPOCHS`]
@@ -207,6 +213,8 @@ pub struct Initializer {
     gyro_bias_sigma_factor: f64,
     /// The newest dual-antenna heading of the body.
     antenna_heading: Option<AntennaHeading>,
+    /// The single-point solutions so far, combined (tightly coupled).
+    position_track: Option<PositionTrack>,
 }
 
 /// A dual-antenna pair's heading of the body's x axis.
@@ -242,6 +250,7 @@ impl Default for Initializer {
             velocity: None,
             gyro_bias_sigma_factor: 1.0,
             antenna_heading: None,
+            position_track: None,
         }
     }
 }
@@ -392,7 +401,20 @@ impl Initializer {
                 confirmed: true,
             });
         }
-        let position_var = sol.covariance.fixed_view::<3, 3>(0, 0).trace() / 3.0;
+        let min_sigma_m = config.init.position_sigma_m;
+        // At rest for the track: the IMU says so, and the Doppler speed (when there is
+        // one) is slow or not significant against its noise.
+        let gnss_moving = velocity.and(self.velocity).is_some_and(|v| {
+            v.speed_h_mps() > REST_SPEED_MAX_MPS && significant(&v.v_enu_mps.xy(), &v.cov_h_m2_s2)
+        });
+        let at_rest = recent.at_rest(&config.imu) && !gnss_moving;
+        let track = match &self.position_track {
+            Some(track) => track.push(epoch.t_s, &sol, min_sigma_m, at_rest),
+            None => PositionTrack::new(epoch.t_s, &sol, min_sigma_m),
+        };
+        let antenna = earth::ecef_to_llh(&track.pos_ecef_m()).unwrap_or(sol.pos_llh);
+        let position_var = track.position_var_enu_m2(&antenna);
+        self.position_track = Some(track);
         let (alignment, from_motion) = match self.attitude.clone() {
             Some(attitude) => {
                 self.position_known = true;
@@ -410,12 +432,14 @@ impl Initializer {
         let clock_drift = velocity.map_or(0.0, |v| v.clock_drift_mps);
         let mut init = self.initial_state(
             epoch.t_s,
-            &sol.pos_llh,
+            &antenna,
             v_enu.unwrap_or_else(Vector3::zeros),
             &alignment,
             config,
             position_var,
         );
+        // The clock is this epoch's solution's, which its position's metre or so from the
+        // combined one shifts by as much: within the clock's start σ (30 m by default).
         init.clock_bias_m = sol.clock_bias_m;
         init.clock_drift_mps = clock_drift;
         init.p[(CLOCK_BIAS, CLOCK_BIAS)] = config
@@ -484,7 +508,7 @@ impl Initializer {
             self.velocity.map_or_else(Vector3::zeros, |v| v.v_enu_mps),
             &alignment,
             config,
-            position_var,
+            Vector3::repeat(position_var.max(config.init.position_sigma_m.powi(2))),
         );
         init.heading_from_motion = from_motion;
         Some(init)
