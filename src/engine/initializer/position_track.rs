@@ -2,11 +2,11 @@
 //! solution since the start-up began, not the last one alone.
 //!
 //! A small Kalman filter on the ECEF position. Each epoch's single-point position is a
-//! measurement of it, with the least squares' covariance, scaled up where the root of its
-//! components' mean variance is below `init.position_sigma_m`. Between epochs it stays where it is
-//! when the platform is at rest (the caller's verdict: the IMU's standstill test and a
-//! slow GNSS speed), and otherwise moves by the mean of the two epochs' Doppler
-//! velocities times the interval, with their covariances and
+//! measurement of it, with the least squares' covariance, scaled up where the root of
+//! its components' mean variance is below `init.position_sigma_m`. Between epochs it
+//! stays where it is when the platform is at rest (the caller's verdict: the IMU's
+//! standstill test and a slow GNSS speed), and otherwise moves by the mean of the two
+//! epochs' Doppler velocities times the interval, with their covariances and
 //! [`UNMODELLED_ACCELERATION_M_S2`]. The usual start — levelled at rest, the heading once
 //! the platform moves — then begins from the combined solutions of the whole rest instead
 //! of one epoch's.
@@ -24,7 +24,7 @@
 //! The track starts again from the epoch's solution when it cannot carry its position
 //! over: moving without a Doppler velocity at both epochs, an interval outside (0,
 //! [`MAX_INTERVAL_S`]], or a solution beyond the chi-square gate of [`GATE_CONFIDENCE`] (a
-//! platform moved without its Doppler, a solution pulled by a bad range).
+//! platform moved without its Doppler, a solution pulled by a bad range) or not finite.
 
 use nalgebra::{Matrix3, Vector3};
 
