@@ -20,7 +20,8 @@ use adaptive_gnss_ins::config::Config;
 use adaptive_gnss_ins::ros::bag::BagReader;
 use adaptive_gnss_ins::ros::cdr;
 use adaptive_gnss_ins::ros::msg::{
-    Clock, GnssMeasurements, Imu, Odometry, RosMessage, TFMessage, TransformStamped,
+    Clock, DiagnosticArray, GnssMeasurements, Imu, Odometry, RosMessage, TFMessage,
+    TransformStamped,
 };
 use adaptive_gnss_ins::sim::{Scenario, ScenarioSpec};
 use adaptive_gnss_ins::tools::bag_run::BagRun;
@@ -303,12 +304,37 @@ fn node_records_the_replay_solution(
     let live = decoded::<Odometry>(&recorded, "/odometry");
     let offline = decoded::<Odometry>(&replayed, "/odometry");
     let worst = largest_difference_of_runs(&live, &offline, "node vs replay");
+    let counts = last_counts(&recorded);
     println!(
-        "node vs replay: {} solutions, largest difference {worst:e}",
+        "node vs replay: {} solutions, largest difference {worst:e}; the node's last counts: {counts}",
         live.len()
     );
-    assert!(worst <= 1e-9, "node and replay differ by {worst}");
+    assert!(
+        worst <= 1e-9,
+        "node and replay differ by {worst}; the node's last counts: {counts}"
+    );
     result
+}
+
+/// The input counts (received, paired, rejected) of the node's last /diagnostics in
+/// `recorded`, the non-zero ones, to tell a sample lost in transport from a difference in
+/// the processing.
+fn last_counts(recorded: &Path) -> String {
+    let Some(last) = decoded::<DiagnosticArray>(recorded, "/diagnostics").pop() else {
+        return "no /diagnostics recorded".to_owned();
+    };
+    last.status
+        .iter()
+        .flat_map(|status| &status.values)
+        .filter(|kv| {
+            ["received", "paired", "rejected"]
+                .iter()
+                .any(|word| kv.key.contains(word))
+                && kv.value != "0"
+        })
+        .map(|kv| format!("{}={}", kv.key, kv.value))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// The node's `/tf` in `tf_mode` `map_to_odom` has its offline twin (issue 16, item 2): a
