@@ -368,8 +368,8 @@ fn arrival_order_at_equal_stamps_does_not_change_the_outputs() {
     }
 }
 
-/// The start's position and its 1-sigma per component (mean of E, N, U variances), and
-/// the start's position NEES, when the filter starts after `leveling_s` of rest.
+/// The 1-sigma of the start's position (the root of the mean of its E, N and U variances)
+/// and the position's NEES, when the filter starts after `leveling_s` of rest.
 fn start_position(seed: u64, leveling_s: f64) -> (f64, f64) {
     let mut scenario = StaticScenario::new(seed);
     let mut config = static_config(scenario.q_nb.euler_angles().2);
