@@ -10,7 +10,10 @@
 //!   correlated when |z| exceeds the two-sided normal quantile at `significance`;
 //! - if correlated, AR(1) by Yule–Walker (a = r₁) and the eq. (29) correction with p = 1:
 //!   Ĉ ← Ĉ / (1 − a r₁) = Ĉ / (1 − r₁²), an inflation;
-//! - R̂ = Ĉ − H P⁻ Hᵀ, floored (see [`InnovationOptions`]).
+//! - R̂ = Ĉ − H P⁻ Hᵀ, floored (see [`InnovationOptions`]);
+//! - resolvability test: R̂ is only reported as resolved when Ĉ exceeds H P⁻ Hᵀ by more
+//!   than its own sampling noise (one-sided χ² test, see
+//!   [`InnovationCovarianceEstimator::push`]).
 //!
 //! Choice (test): the lag-1 z-test, because the correction it gates is an AR(1) model; a
 //! Ljung–Box test over more lags would flag correlations that AR(1) does not model.
@@ -19,7 +22,7 @@
 
 use std::collections::VecDeque;
 
-use statrs::distribution::{ContinuousCDF, Normal};
+use statrs::distribution::{ChiSquared, ContinuousCDF, Normal};
 
 use super::ar_variance::{ar_corrected_variance, autocorrelation_coefficients, mean_square};
 use super::error::{check_finite, AdaptiveError};
@@ -32,7 +35,8 @@ pub struct InnovationOptions {
     /// Innovations needed before the first estimate (epochs); at least 3, at most
     /// `window_size`. Default 20.
     pub min_samples: usize,
-    /// Two-sided significance level α of the lag-1 whiteness test, in (0, 1). Default 0.05.
+    /// Two-sided significance level α of the lag-1 whiteness test, and one-sided level of
+    /// the resolvability test, in (0, 1). Default 0.05.
     pub significance: f64,
     /// Absolute floor of R̂ (unit of ν, squared). Default 0, i.e. only the relative floor.
     pub min_variance: f64,
@@ -123,6 +127,11 @@ pub struct InnovationEstimate {
     pub r_variance: f64,
     /// True when a floor set `r_variance`.
     pub floored: bool,
+    /// True when the window resolves R: the corrected Ĉ is significantly above H P⁻ Hᵀ.
+    /// False: Ĉ is within its own sampling noise of what the predicted covariance alone
+    /// explains, and `r_variance` is a difference of two nearly equal numbers that says
+    /// nothing about R.
+    pub resolved: bool,
 }
 
 /// Outcome of [`InnovationCovarianceEstimator::push`].
@@ -144,6 +153,10 @@ pub enum InnovationOutcome {
 pub struct InnovationCovarianceEstimator {
     options: InnovationOptions,
     critical_z: f64,
+    /// χ²ₖ(1 − α)/k for k = 1 ..= `window_size` degrees of freedom (index k − 1): the
+    /// ratio Ĉ / H P⁻ Hᵀ that a window of k independent innovations exceeds with
+    /// probability α when R = 0.
+    resolvable_ratio: Vec<f64>,
     window: VecDeque<f64>,
 }
 
@@ -153,9 +166,22 @@ impl InnovationCovarianceEstimator {
         options.validate()?;
         let standard_normal = Normal::standard();
         let critical_z = standard_normal.inverse_cdf(1.0 - options.significance / 2.0);
+        let resolvable_ratio = (1..=options.window_size)
+            .map(|k| {
+                let dof = k as f64;
+                ChiSquared::new(dof)
+                    .map(|d| d.inverse_cdf(1.0 - options.significance) / dof)
+                    .map_err(|_| AdaptiveError::InvalidParameter {
+                        name: "window_size",
+                        value: dof,
+                        reason: "no χ² distribution with these degrees of freedom",
+                    })
+            })
+            .collect::<Result<_, _>>()?;
         Ok(Self {
             window: VecDeque::with_capacity(options.window_size),
             critical_z,
+            resolvable_ratio,
             options,
         })
     }
@@ -182,6 +208,19 @@ impl InnovationCovarianceEstimator {
     /// `min_variance`) with Ĉ the corrected innovation variance. A difference at or below
     /// zero means the predicted covariance already explains the innovations; a fraction of
     /// Ĉ keeps R̂ positive and on the scale of the data whatever the observable's unit.
+    ///
+    /// Choice (resolvability): when H P⁻ Hᵀ is of the size of R, Ĉ − H P⁻ Hᵀ is the
+    /// difference of two nearly equal numbers, and Ĉ carries a sampling error of about
+    /// Ĉ·√(2/N). A P⁻ that is a little pessimistic (a conservative process noise, or the
+    /// slow error part added to R) then pushes R̂ to the floor, and the filter, weighing
+    /// its measurements by that R̂, becomes over-confident (a mean open-sky NEES of 14–29
+    /// for 9 degrees of freedom, from pseudo-range rates whose H P⁻ Hᵀ exceeds R). So the
+    /// estimate is `resolved` only when N_eff·Ĉ / H P⁻ Hᵀ exceeds the χ²(N_eff) quantile
+    /// at 1 − `significance`: the window's innovations are then, at that level, more than
+    /// the predicted covariance explains. N_eff is N, or N(1 − r₁²)/(1 + r₁²) when the
+    /// AR(1) correction applies (the variance of a correlated window's mean square). The
+    /// test uses the newest H P⁻ Hᵀ for the whole window, which changes slowly between
+    /// epochs. The caller decides what to use when R is not resolved.
     ///
     /// Errors: non-finite input or a negative `hph` (the estimator is left unchanged).
     pub fn push(&mut self, innovation: f64, hph: f64) -> Result<InnovationOutcome, AdaptiveError> {
@@ -226,6 +265,15 @@ impl InnovationCovarianceEstimator {
         let floor = (self.options.min_fraction_of_innovation * corrected_innovation_variance)
             .max(self.options.min_variance);
         let floored = difference < floor;
+        let effective_samples = if correlated {
+            let r1_squared = r1 * r1;
+            n as f64 * (1.0 - r1_squared) / (1.0 + r1_squared)
+        } else {
+            n as f64
+        };
+        // Truncated to whole degrees of freedom, at least one: fewer make the test stricter.
+        let dof_index = (effective_samples.floor() as usize).clamp(1, n) - 1;
+        let resolved = corrected_innovation_variance > self.resolvable_ratio[dof_index] * hph;
         Ok(InnovationOutcome::Ready(InnovationEstimate {
             n_samples: n,
             innovation_variance,
@@ -235,6 +283,7 @@ impl InnovationCovarianceEstimator {
             corrected_innovation_variance,
             r_variance: if floored { floor } else { difference },
             floored,
+            resolved,
         }))
     }
 }
@@ -277,6 +326,33 @@ mod tests {
         assert!(!e.correlated);
         assert!((e.r_variance - 0.8).abs() < 1e-15);
         assert!(!e.floored);
+        // Ĉ / H P Hᵀ = 5 against χ²₄(0.95)/4 = 2.372.
+        assert!(e.resolved);
+    }
+
+    #[test]
+    fn resolved_only_when_the_window_exceeds_the_predicted_covariance_significantly() {
+        // ν = ±1 alternating over N = 4 (white at 5 %): Ĉ = 1, N Ĉ / H P Hᵀ against
+        // χ²₄(0.95) = 9.4877: resolved below H P Hᵀ = 4/9.4877 = 0.4216, not above it.
+        let opts = InnovationOptions {
+            window_size: 4,
+            min_samples: 4,
+            ..InnovationOptions::default()
+        };
+        let last = |hph: f64| {
+            let mut est = InnovationCovarianceEstimator::new(opts.clone()).unwrap();
+            let outcomes: Vec<_> = [1.0, -1.0, 1.0, -1.0]
+                .iter()
+                .map(|&v| est.push(v, hph).unwrap())
+                .collect();
+            ready(outcomes[3])
+        };
+        let limit = 4.0 / 9.487_729_036_781_154;
+        assert!(last(limit * 0.99).resolved);
+        let unresolved = last(limit * 1.01);
+        assert!(!unresolved.resolved);
+        // Its difference is still positive: significance, not sign, decides.
+        assert!(!unresolved.floored && unresolved.r_variance > 0.5);
     }
 
     #[test]
@@ -301,6 +377,7 @@ mod tests {
         assert!(e.corrected_innovation_variance > e.innovation_variance);
         assert!(e.floored);
         assert!((e.r_variance - 0.1 * e.corrected_innovation_variance).abs() < 1e-15);
+        assert!(!e.resolved);
     }
 
     #[test]

@@ -442,7 +442,8 @@ parameter_table! {
         /// Innovation window of the eiakf (innovation-based) estimator.
         innovation_window: usize = 50,
             unit "epochs", range Range::Count { min: 10, max: MAX_WINDOW_EPOCHS }, at_start;
-        /// Significance level of the eiakf whiteness test of the innovations.
+        /// Significance level of the eiakf whiteness test of the innovations, and of its
+        /// test that their variance exceeds H P⁻ Hᵀ (otherwise the nominal σ is used).
         innovation_significance: f64 = 0.05,
             unit "", range Range::Within(Interval::closed(1e-6, 0.5)), at_start;
         /// Lower bound on an estimated pseudo-range 1-sigma.

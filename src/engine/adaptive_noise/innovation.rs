@@ -73,14 +73,18 @@ impl InnovationNoise {
         track.last_t_s = t_s;
         let innovation = row.measured - row.predicted;
         let verdict = match track.estimator.push(innovation, row.hph) {
-            Ok(InnovationOutcome::Ready(est)) => NoiseVerdict {
+            // Choice: a window that cannot resolve R (see `InnovationEstimate::resolved`)
+            // gives the nominal variance of the fixed σ model, not its floored estimate:
+            // the model is what the filter would use with no estimator at all, while the
+            // floor would claim a precision nothing measured.
+            Ok(InnovationOutcome::Ready(est)) if est.resolved => NoiseVerdict {
                 r: est.r_variance.clamp(r_min, r_max),
                 estimated: true,
                 kde_credibility: f64::NAN,
                 gaussian: None,
                 ar_order: est.correlated.then_some(1),
             },
-            Ok(InnovationOutcome::NotEnoughData { .. }) | Err(_) => {
+            Ok(InnovationOutcome::Ready(_) | InnovationOutcome::NotEnoughData { .. }) | Err(_) => {
                 NoiseVerdict::nominal(row.r_nominal)
             }
         };
@@ -90,5 +94,58 @@ impl InnovationNoise {
 
     pub fn reset(&mut self) {
         self.tracks.clear();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::filter::measurement_rows::Row;
+    use crate::gnss::Constellation;
+
+    fn rate_row(innovation: f64, hph: f64) -> ScalarMeasurement {
+        ScalarMeasurement {
+            sat: SatId {
+                constellation: Constellation::Gps,
+                prn: 5,
+            },
+            observable: Observable::PseudorangeRate,
+            measured: innovation,
+            predicted: 0.0,
+            hph,
+            row: Row::zeros(),
+            r_nominal: 0.04,
+            r_slow: 0.0,
+        }
+    }
+
+    /// The last verdict after a full window of innovations of ±0.2 m/s in the pattern
+    /// + + − − (Ĉ = 0.04, lag-1 autocorrelation 0.02: white) with `hph` on every row.
+    fn verdict_after_a_window(hph: f64) -> NoiseVerdict {
+        let config = Config::default();
+        let mut noise = InnovationNoise::new(&config);
+        let epochs = config.adaptive.innovation_window;
+        let mut last = None;
+        for k in 0..epochs {
+            let sign = if k % 4 < 2 { 1.0 } else { -1.0 };
+            last = Some(noise.variance(k as f64, &rate_row(0.2 * sign, hph), true));
+        }
+        last.unwrap()
+    }
+
+    #[test]
+    fn a_window_the_predicted_covariance_explains_gives_the_nominal_variance() {
+        // H P Hᵀ = 0.035 of Ĉ = 0.04: the difference 0.005 is within the sampling noise of
+        // Ĉ over 50 epochs, so the filter keeps the nominal 0.04, not an R of 0.005.
+        let v = verdict_after_a_window(0.035);
+        assert!(!v.estimated);
+        assert_eq!(v.r, 0.04);
+    }
+
+    #[test]
+    fn a_window_well_above_the_predicted_covariance_gives_its_estimate() {
+        let v = verdict_after_a_window(0.01);
+        assert!(v.estimated);
+        assert!((v.r - 0.03).abs() < 1e-12, "{}", v.r);
     }
 }
