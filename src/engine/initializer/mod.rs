@@ -4,7 +4,7 @@
 //!    `init.leveling_duration_s`, and the gyro bias from the mean angular rate less the
 //!    earth rate (resolved once the position and heading are known) — only when the
 //!    window is at rest: the standstill test of [`super::standstill`] over the window, and
-//!    a GNSS speed (when one is known) below [`REST_SPEED_MAX_MPS`]. A moving
+//!    no GNSS speed (when one is known) that denies it ([`REST_SPEED_MAX_MPS`]). A moving
 //!    window gives no attitude and no gyro bias (a turn's rate is no bias); the next window
 //!    is tried.
 //! 2. Until the filter starts, the levelled attitude is carried forward by the gyros alone.
@@ -62,9 +62,9 @@ const SPEED_AGE_S: f64 = 2.0;
 /// a receiver velocity takes a heading. Choice: 3, so that one fix pulled by noise or an
 /// outlier does not set the heading.
 const MOTION_EPOCHS: usize = 3;
-/// A GNSS speed above this denies the levelling's rest, and the start position track's
-/// when significant (m/s). Choice: 0.5 m/s, above the speed noise of a single-point
-/// velocity and below a walking pace.
+/// A horizontal GNSS speed above this, when significant, denies the levelling's rest and
+/// the start position track's (m/s). Choice: 0.5 m/s, above the speed noise of a
+/// single-point velocity and below a walking pace.
 const REST_SPEED_MAX_MPS: f64 = 0.5;
 /// Confidence of the test that a GNSS velocity differs from zero. Choice: 0.999, so that
 /// fix noise at a standstill passes it once in a thousand fixes, and [`MOTION_EPOCHS`]
@@ -138,6 +138,14 @@ struct GnssVelocity {
 impl GnssVelocity {
     fn speed_h_mps(&self) -> f64 {
         self.v_enu_mps.xy().norm()
+    }
+
+    /// Denies a rest (the levelling's and the start position track's): the horizontal
+    /// speed exceeds [`REST_SPEED_MAX_MPS`] and is significant against its covariance, so
+    /// that the speed noise of a standing receiver does not deny it.
+    fn denies_rest(&self) -> bool {
+        self.speed_h_mps() > REST_SPEED_MAX_MPS
+            && significant(&self.v_enu_mps.xy(), &self.cov_h_m2_s2)
     }
 
     /// Moving: the horizontal speed reaches `init.heading_min_speed_mps` and is significant
@@ -341,9 +349,9 @@ impl Initializer {
         lev.stats.push(s);
         if s.t_s - lev.t_start_s >= config.init.leveling_duration_s && lev.stats.count() >= 2 {
             let imu_at_rest = lev.stats.at_rest(&config.imu);
-            let gnss_moving = self.velocity.is_some_and(|v| {
-                v.t_s >= lev.t_start_s - SPEED_AGE_S && v.v_enu_mps.norm() > REST_SPEED_MAX_MPS
-            });
+            let gnss_moving = self
+                .velocity
+                .is_some_and(|v| v.t_s >= lev.t_start_s - SPEED_AGE_S && v.denies_rest());
             let (f, w) = (lev.stats.mean_f(), lev.stats.mean_w());
             let window_s = lev.stats.duration_s();
             self.leveling = None;
@@ -404,9 +412,7 @@ impl Initializer {
         let min_sigma_m = config.init.position_sigma_m;
         // At rest for the track: the IMU says so, and the Doppler speed (when there is
         // one) is slow or not significant against its noise.
-        let gnss_moving = velocity.and(self.velocity).is_some_and(|v| {
-            v.speed_h_mps() > REST_SPEED_MAX_MPS && significant(&v.v_enu_mps.xy(), &v.cov_h_m2_s2)
-        });
+        let gnss_moving = velocity.and(self.velocity).is_some_and(|v| v.denies_rest());
         let at_rest = recent.at_rest(&config.imu) && !gnss_moving;
         let track = match &self.position_track {
             Some(track) => track.push(epoch.t_s, &sol, min_sigma_m, at_rest),
