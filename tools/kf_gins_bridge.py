@@ -232,7 +232,11 @@ def kf_gins_noise(p: dict[str, object]) -> dict:
     Gauss-Markov state: its steady sigma gbstd is our drift's (same Q = 2 sigma^2 / T) and
     its initial sigma (initbgstd) the root sum square of both. The accelerometer bias is
     one Gauss-Markov state in both. KF-GINS has one correlation time for every bias and
-    scale factor: our gyro drift's (the others are reported when they differ)."""
+    scale factor: our gyro drift's (the others are reported when they differ). A state
+    whose own time T differs keeps its driving noise Q = 2 sigma^2 / T there: its steady
+    sigma becomes sigma * sqrt(T_kfgins / T), its initial sigma stays sigma. (Copying
+    sigma unchanged gave the consumer-MEMS hour's accelerometer bias, 30 mg over 10 h,
+    120 times our process noise at KF-GINS's 300 s.)"""
     g = lambda k: float(p[f'imu.{k}'])
     times = {k: g(k) for k in ('gyro_markov_correlation_time_s',
                                 'accel_bias_correlation_time_s',
@@ -240,6 +244,8 @@ def kf_gins_noise(p: dict[str, object]) -> dict:
     if len(set(times.values())) > 1:
         print(f'note: KF-GINS has one correlation time; ours are {times}; '
               f'taking gyro_markov_correlation_time_s', file=sys.stderr)
+    t_kf = times['gyro_markov_correlation_time_s']
+    same_q = lambda sigma, t: sigma * math.sqrt(t_kf / t)
     arw = g('gyro_arw_deg_per_sqrt_h')
     vrw = g('accel_vrw_ug_per_sqrt_hz') * MICRO_G * 60.0  # m/s/sqrt(h)
     gb = g('gyro_markov_sigma_deg_per_h')
@@ -247,9 +253,11 @@ def kf_gins_noise(p: dict[str, object]) -> dict:
     ab = g('accel_bias_ug') * MICRO_G / MGAL
     gs, as_ = g('gyro_scale_factor_ppm'), g('accel_scale_factor_ppm')
     return {
-        'imunoise': {'arw': [arw] * 3, 'vrw': [vrw] * 3, 'gbstd': [gb] * 3, 'abstd': [ab] * 3,
-                     'gsstd': [gs] * 3, 'asstd': [as_] * 3,
-                     'corrtime': times['gyro_markov_correlation_time_s'] / 3600.0},
+        'imunoise': {'arw': [arw] * 3, 'vrw': [vrw] * 3, 'gbstd': [gb] * 3,
+                     'abstd': [same_q(ab, times['accel_bias_correlation_time_s'])] * 3,
+                     'gsstd': [same_q(gs, times['scale_factor_correlation_time_s'])] * 3,
+                     'asstd': [same_q(as_, times['scale_factor_correlation_time_s'])] * 3,
+                     'corrtime': t_kf / 3600.0},
         'initbgstd': [gb0] * 3,
         'initbastd': [ab] * 3,
         'initsgstd': [gs] * 3,
