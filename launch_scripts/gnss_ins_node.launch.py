@@ -8,7 +8,7 @@
         namespace:=/robot imu_topic:=/sensors/imu time_base:=host
 
 Arguments:
-- params_file: a parameter file loaded after the manual params/ekf.yaml (which holds
+- params_file: a parameter file loaded after the manual params/defaults.yaml (which holds
   every parameter at its default): a preset of params/ (they hold only what differs from
   the manual) or a file of your own; default: the manual itself (loaded once).
   namespace, node_name, log_level;
@@ -46,7 +46,7 @@ from launch_ros.actions import Node
 
 PACKAGE_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 # The manual: every parameter at its default; the presets are overlays on it.
-MANUAL_PARAMS = os.path.join(PACKAGE_ROOT, 'params', 'ekf.yaml')
+MANUAL_PARAMS = os.path.join(PACKAGE_ROOT, 'params', 'defaults.yaml')
 
 # The node's own parameters (src/ros/node/params.rs, NODE_PARAMETERS): name -> (type,
 # description). The descriptions name the node's defaults.
@@ -171,7 +171,7 @@ def _launch_node(context):
 def generate_launch_description():
     arguments = [
         DeclareLaunchArgument('params_file', default_value=MANUAL_PARAMS,
-                              description='parameter file loaded after params/ekf.yaml (a '
+                              description='parameter file loaded after params/defaults.yaml (a '
                                           'preset of params/ or your own)'),
         DeclareLaunchArgument('namespace', default_value='',
                               description='namespace of the node and its topics'),

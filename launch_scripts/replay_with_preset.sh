@@ -5,7 +5,7 @@
 #   launch_scripts/replay_with_preset.sh BAG.mcap [PRESET] [extra gnss_ins replay args]
 #
 # PRESET is a file name of params/ without .yaml (default: ermakf), e.g. ekf, srmakf;
-# it is loaded after the manual params/ekf.yaml (the presets hold only what differs).
+# it is loaded after the manual params/defaults.yaml (the presets hold only what differs).
 # With GNSS_INS_DRY_RUN=1 the command is printed instead of run.
 set -euo pipefail
 
@@ -17,7 +17,7 @@ repo_root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bag="$1"
 preset="${2:-ermakf}"
 shift $(( $# >= 2 ? 2 : 1 ))
-manual="${repo_root}/params/ekf.yaml"
+manual="${repo_root}/params/defaults.yaml"
 params="${repo_root}/params/${preset}.yaml"
 if [[ ! -f "${params}" ]]; then
     echo "$0: no preset ${params}" >&2

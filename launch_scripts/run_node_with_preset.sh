@@ -5,7 +5,7 @@
 #   launch_scripts/run_node_with_preset.sh [PRESET] [NAME:=VALUE ...] [extra ROS arguments]
 #
 # PRESET is a file name of params/ without .yaml (default: ermakf), e.g. ekf, ekf_loose;
-# it is loaded after the manual params/ekf.yaml (the presets hold only what differs).
+# it is loaded after the manual params/defaults.yaml (the presets hold only what differs).
 # NAME:=VALUE sets one of the node's own parameters as the launch file's arguments do:
 # use_sim_time, map_frame, base_frame, odom_frame, publish_tf, tf_mode, queue_depth,
 # imu_frame (passed as -p NAME:=VALUE, which wins over the preset). Extra arguments follow --ros-args, e.g. -r __ns:=/robot
@@ -19,7 +19,7 @@ node_parameters=(use_sim_time map_frame base_frame odom_frame publish_tf tf_mode
 repo_root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 preset="${1:-ermakf}"
 shift $(( $# >= 1 ? 1 : 0 ))
-manual="${repo_root}/params/ekf.yaml"
+manual="${repo_root}/params/defaults.yaml"
 params="${repo_root}/params/${preset}.yaml"
 if [[ ! -f "${params}" ]]; then
     echo "$0: no preset ${params}" >&2

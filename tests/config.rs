@@ -1,5 +1,5 @@
 //! The configuration loader against the preset files in `params/` and against bad input.
-//! Every preset but the manual (`params/ekf.yaml`) is an overlay loaded after it.
+//! Every preset but the manual (`params/defaults.yaml`) is an overlay loaded after it.
 
 use std::path::{Path, PathBuf};
 
@@ -27,7 +27,7 @@ fn preset_files() -> Vec<PathBuf> {
 
 /// The preset `name` as it is meant to be loaded: over the manual.
 fn load(name: &str) -> Config {
-    config_from_files(&[params_dir().join("ekf.yaml"), params_dir().join(name)])
+    config_from_files(&[params_dir().join("defaults.yaml"), params_dir().join(name)])
         .unwrap_or_else(|e| panic!("{name}: {e}"))
 }
 
@@ -258,18 +258,24 @@ fn robust_constants_out_of_range_are_refused() {
 }
 
 /// Each preset other than the manual holds only keys whose value differs from the
-/// manual's (so a preset says exactly how it differs).
+/// manual's (so a preset says exactly how it differs); ekf.yaml only its variant.
 #[test]
 fn every_overlay_holds_only_what_differs_from_the_manual() {
     let defaults = Config::default().parameters();
     for path in preset_files() {
-        if path.ends_with("ekf.yaml") {
+        if path.ends_with("defaults.yaml") {
             continue;
         }
         let text = std::fs::read_to_string(&path).unwrap();
         let entries = adaptive_gnss_ins::config::parse_parameter_file(&text, "p").unwrap();
         assert_eq!(entries.len(), 1, "{path:?}");
         assert!(!entries[0].values.is_empty(), "{path:?}");
+        // The baseline's preset states its variant, the default, and nothing else.
+        if path.ends_with("ekf.yaml") {
+            assert_eq!(entries[0].values.len(), 1, "{path:?}");
+            assert_eq!(entries[0].values[0].0, "filter.variant", "{path:?}");
+            continue;
+        }
         for (name, value) in &entries[0].values {
             let (_, default) = defaults
                 .iter()
@@ -294,7 +300,7 @@ fn every_overlay_over_the_manual_is_the_full_preset_it_replaced() {
         let name = path.file_name().unwrap().to_string_lossy().into_owned();
         // The IMU-class overlays (params/imu_*.yaml, issue 11) came after the overlays
         // replaced the full presets: there is no full file they replaced.
-        if name == "ekf.yaml" || name.starts_with("imu_") {
+        if name == "defaults.yaml" || name == "ekf.yaml" || name.starts_with("imu_") {
             continue;
         }
         let full = std::fs::read_to_string(before.join(&name))

@@ -39,7 +39,7 @@ fn every_variant_loosely_coupled_stays_near_the_ekf_on_a_consumer_mems_drive() {
     let bag = dir.path().join("drive.mcap");
     simulate(&scenario, &bag).unwrap();
     let base = config_from_files(&[
-        repo("params/ekf.yaml"),
+        repo("params/defaults.yaml"),
         repo("params/ekf_loose.yaml"),
         repo("params/imu_consumer_mems.yaml"),
     ])

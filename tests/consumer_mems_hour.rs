@@ -104,7 +104,7 @@ fn assert_the_hours_bounds(files: &[&str], variants: &[FilterVariant]) {
 fn every_variant_loosely_coupled_meets_the_hours_bounds() {
     assert_the_hours_bounds(
         &[
-            "params/ekf.yaml",
+            "params/defaults.yaml",
             "params/ekf_loose.yaml",
             "params/imu_consumer_mems.yaml",
         ],
@@ -122,7 +122,7 @@ fn every_variant_loosely_coupled_meets_the_hours_bounds() {
 fn every_variant_tightly_coupled_meets_the_hours_bounds() {
     let variants: Vec<FilterVariant> = VARIANTS.iter().map(|spec| spec.variant).collect();
     assert_the_hours_bounds(
-        &["params/ekf.yaml", "params/imu_consumer_mems.yaml"],
+        &["params/defaults.yaml", "params/imu_consumer_mems.yaml"],
         &variants,
     );
 }

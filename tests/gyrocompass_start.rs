@@ -40,7 +40,7 @@ fn repo(path: &str) -> PathBuf {
 /// The class preset loosely coupled, the fixes taken at the IMU (no lever arm).
 fn config(imu_preset: &str) -> Config {
     let mut config = config_from_files(&[
-        repo("params/ekf.yaml"),
+        repo("params/defaults.yaml"),
         repo("params/ekf_loose.yaml"),
         repo(imu_preset),
     ])

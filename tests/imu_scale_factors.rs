@@ -31,7 +31,7 @@ const GYRO_Z_SCALE_ERROR: f64 = 600e-6;
 
 fn tactical_loose() -> Config {
     config_from_files(&[
-        repo("params/ekf.yaml"),
+        repo("params/defaults.yaml"),
         repo("params/ekf_loose.yaml"),
         repo("params/imu_tactical.yaml"),
     ])

@@ -62,8 +62,8 @@ fn python_launch_file_parses_and_names_existing_things() {
         String::from_utf8_lossy(&out.stderr)
     );
     // The default params file, relative to the package root, exists.
-    assert!(text.contains("os.path.join(PACKAGE_ROOT, 'params', 'ekf.yaml')"));
-    assert!(root().join("params/ekf.yaml").is_file());
+    assert!(text.contains("os.path.join(PACKAGE_ROOT, 'params', 'defaults.yaml')"));
+    assert!(root().join("params/defaults.yaml").is_file());
     // The executable it starts is a binary of this crate.
     assert!(text.contains("executable='gnss_ins_node'"));
     assert!(root().join("src/bin/gnss_ins_node.rs").is_file());
@@ -295,7 +295,7 @@ fn the_readme_launch_example_loads_as_launch_ros_runs_it() {
     )
     .unwrap();
     let launched = LaunchedArgv::parse(&json);
-    let manual = root().join("params/ekf.yaml").display().to_string();
+    let manual = root().join("params/defaults.yaml").display().to_string();
     let argv: Vec<&str> = launched.argv.iter().map(String::as_str).collect();
     assert_eq!(
         argv[..16],
@@ -454,7 +454,7 @@ fn with_ubx_adapter_starts_both_nodes_as_a_ublox_dgnss_user_needs() {
     let (filter, ubx) = (&nodes[0], &nodes[1]);
     assert_eq!(ubx.argv[0], "gnss_ins_ubx_node");
     assert!(
-        !ubx.argv.iter().any(|a| a.ends_with("ekf.yaml")),
+        !ubx.argv.iter().any(|a| a.ends_with("defaults.yaml")),
         "the filter's manual is no parameter file of the adapter: {:?}",
         ubx.argv
     );
@@ -539,7 +539,14 @@ fn shell_script_passes_node_parameters_as_p() {
     }
     let plain = shell_command(&["ekf"]).unwrap();
     assert!(plain.trim_end().ends_with("params/ekf.yaml"), "{plain}");
-    assert_eq!(plain.matches("--params-file").count(), 1, "{plain}");
+    assert_eq!(plain.matches("--params-file").count(), 2, "{plain}");
+    // The manual is not given twice.
+    let manual = shell_command(&["defaults"]).unwrap();
+    assert!(
+        manual.trim_end().ends_with("params/defaults.yaml"),
+        "{manual}"
+    );
+    assert_eq!(manual.matches("--params-file").count(), 1, "{manual}");
     let e = shell_command(&["ekf", "map_frme:=odom"]).unwrap_err();
     assert!(e.contains("map_frme is not a node parameter"), "{e}");
 }
@@ -556,7 +563,7 @@ fn program_args(command: &str) -> Vec<String> {
 #[test]
 fn shell_scripts_load_the_preset_over_the_manual() {
     let command = shell_command(&["ermakf", "publish_tf:=true"]).unwrap();
-    let manual = root().join("params/ekf.yaml");
+    let manual = root().join("params/defaults.yaml");
     let preset = root().join("params/ermakf.yaml");
     assert!(
         command.contains(&format!(

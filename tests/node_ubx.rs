@@ -61,7 +61,7 @@ const IMU_PAUSE: Duration = Duration::from_micros(1000);
 fn params_files() -> [PathBuf; 2] {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     [
-        root.join("params/ekf.yaml"),
+        root.join("params/defaults.yaml"),
         root.join("params/walk_0827.yaml"),
     ]
 }

@@ -1,4 +1,4 @@
-//! The parameter table against what is generated from it: `params/ekf.yaml` (the
+//! The parameter table against what is generated from it: `params/defaults.yaml` (the
 //! commented manual, and the base every other preset is loaded over) and
 //! `docs/parameters.md` (the reference). A stale file fails here with the command that
 //! regenerates it; `GNSS_INS_REGENERATE=1 cargo test --test parameter_manual` rewrites
@@ -39,7 +39,7 @@ fn check_generated(path: PathBuf, expected: &str) {
 
 #[test]
 fn the_manual_is_generated_from_the_table() {
-    check_generated(root().join("params/ekf.yaml"), &manual::manual_file());
+    check_generated(root().join("params/defaults.yaml"), &manual::manual_file());
 }
 
 #[test]
@@ -54,7 +54,7 @@ fn the_reference_is_generated_from_the_table() {
 fn the_manual_states_every_default_and_loads_to_them() {
     let text = manual::manual_file();
     assert_eq!(
-        Config::from_yaml_str(&text, "ekf.yaml").unwrap(),
+        Config::from_yaml_str(&text, "defaults.yaml").unwrap(),
         Config::default()
     );
     for p in config::parameter_table() {

@@ -37,7 +37,7 @@ struct Replayed {
     stderr: String,
 }
 
-/// `gnss_ins replay BAG --params params/ekf.yaml --params NODE --out OUT` with NODE a
+/// `gnss_ins replay BAG --params params/defaults.yaml --params NODE --out OUT` with NODE a
 /// launch-style `/**` file holding the node's datum and heading (as node_tf starts the
 /// node) and `node_parameters`.
 fn replay(bag: &Path, node_parameters: &str) -> Replayed {

@@ -45,7 +45,7 @@ fn replay_takes_the_manual_then_a_launch_style_file() {
         "replay",
         BAG,
         "--params",
-        "params/ekf.yaml",
+        "params/defaults.yaml",
         "--params",
         file.to_str().unwrap(),
     ]);
@@ -67,7 +67,7 @@ fn compare_overlays_each_preset_on_the_params_files() {
         "compare",
         BAG,
         "--params",
-        "params/ekf.yaml",
+        "params/defaults.yaml",
         "--params-dir",
         "params",
         "--filters",

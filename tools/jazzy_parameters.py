@@ -5,7 +5,7 @@ Usage: jazzy_parameters.py --namespace NS --node NAME [--require-parameter-event
 
 Lists, reads, types, describes and sets the node's parameters through
 rclpy.parameter_client.AsyncParameterClient, as `ros2 param` does, and checks the answers
-against the node's documented behaviour (params/ekf.yaml defaults; a description for every
+against the node's documented behaviour (params/defaults.yaml defaults; a description for every
 parameter; the runtime parameters settable, the others read-only and a set of them refused
 with the reason; an invalid value refused; an atomic set all or nothing). Leaves every
 parameter as it found it. It also listens on /parameter_events and reports what the node

@@ -2,7 +2,7 @@
 used by cyclonedds_peer.py --parameters against gnss_ins_node's parameter services.
 
 `exercise` lists, reads, describes and sets parameters, checks the answers against the
-node's documented behaviour (params/ekf.yaml defaults; runtime parameters settable,
+node's documented behaviour (params/defaults.yaml defaults; runtime parameters settable,
 the rest read-only) and leaves every parameter as it found it. It listens on
 /parameter_events (reliable, keep last 1000, as rclcpp's subscribers) and requires one
 event with the name and the new value in changed_parameters per accepted set, and none

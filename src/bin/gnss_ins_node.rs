@@ -1,5 +1,5 @@
 //! `gnss_ins_node`: the ROS 2 node. Takes ROS arguments as rcl does, e.g.
-//! `gnss_ins_node --ros-args --params-file params/ekf.yaml -r imu:=/sensors/imu`
+//! `gnss_ins_node --ros-args --params-file params/defaults.yaml -r imu:=/sensors/imu`
 //! (`gnss_ins_node --help` lists them).
 
 use std::process::ExitCode;

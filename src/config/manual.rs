@@ -1,5 +1,5 @@
 //! Text generated from the parameter table: the echo of a configuration, the commented
-//! manual `params/ekf.yaml` and the reference `docs/parameters.md` (the last two are
+//! manual `params/defaults.yaml` and the reference `docs/parameters.md` (the last two are
 //! checked against their files by `tests/parameter_manual.rs`).
 
 use std::fmt::Write as _;
@@ -18,17 +18,18 @@ const WIDTH: usize = 90;
 pub const REGENERATE: &str = "GNSS_INS_REGENERATE=1 cargo test --test parameter_manual";
 
 const MANUAL_HEADER: &str = "\
-adaptive_gnss_ins: the manual, and the preset \"ekf\" (tightly-coupled error-state EKF, fixed \
-noise).
+adaptive_gnss_ins: the manual (tightly-coupled error-state EKF with fixed noise, the \
+built-in defaults).
 
 Every parameter is listed with its meaning, unit, range and default, and the values below ARE \
 the defaults. Any key may be left out and then takes its default. An unknown key, a value of \
 the wrong type or out of range is an error naming the key and this file; nothing is processed.
 
-The other presets of params/ hold only the keys that differ from this file and are loaded \
-after it (a later file wins):
-  --ros-args --params-file params/ekf.yaml --params-file params/ermakf.yaml
-  gnss_ins replay BAG --params params/ekf.yaml --params params/ermakf.yaml
+The presets of params/ (ekf.yaml, ermakf.yaml, ekf_loose.yaml, imu_*.yaml, ...) hold only the \
+keys that differ from this file (ekf.yaml only its variant) and are loaded after it (a later \
+file wins):
+  --ros-args --params-file params/defaults.yaml --params-file params/ermakf.yaml
+  gnss_ins replay BAG --params params/defaults.yaml --params params/ermakf.yaml
 Override one key:  --ros-args -p imu.gyro_bias_deg_per_h:=0.3
 
 The parameters are keyed `/**`, so they reach the node under any name and namespace.
@@ -81,7 +82,7 @@ pub fn values_file(config: &Config) -> String {
     text
 }
 
-/// `params/ekf.yaml`: every parameter with its manual text, unit, range and default.
+/// `params/defaults.yaml`: every parameter with its manual text, unit, range and default.
 pub fn manual_file() -> String {
     let mut text = String::new();
     for paragraph in MANUAL_HEADER.lines() {
@@ -132,7 +133,7 @@ pub fn reference(node_rows: &[Row]) -> String {
         text,
         "Generated from the parameter table (`src/config/parameters.rs`) and the node's own \
          parameters (`src/ros/node/params.rs`); edit those, not this file, and regenerate \
-         with `{REGENERATE}`. `params/ekf.yaml` is the same manual as a parameter file.\n\n\
+         with `{REGENERATE}`. `params/defaults.yaml` is the same manual as a parameter file.\n\n\
          Names are those of the parameter file (`section.key`, nested or dotted) and of the \
          ROS parameter services. \"Run time: yes\" means the running node takes a new value \
          (`ros2 param set`); the others are read-only while it runs and are set in a \

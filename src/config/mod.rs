@@ -11,7 +11,7 @@
 //!
 //! Every parameter is declared once, in the table of `parameters.rs`, with its type,
 //! unit, default, range, run-time flag, SI conversion and manual text; the section
-//! structs, the loader, the echo and the manual (`params/ekf.yaml`, `docs/parameters.md`)
+//! structs, the loader, the echo and the manual (`params/defaults.yaml`, `docs/parameters.md`)
 //! come from it. Every key is optional and takes its default. An unknown key, a wrong
 //! type or an out-of-range value is an error naming the key and the origin, and nothing
 //! is applied. The core reads no files: the caller hands over the text and the name to

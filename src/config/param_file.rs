@@ -14,7 +14,7 @@ use super::ConfigError;
 
 /// Largest parameter file (and `-p` value) accepted, in bytes.
 ///
-/// Choice: 1 MiB. The full manual (`params/ekf.yaml`) is about 20 kB; a file a hundred
+/// Choice: 1 MiB. The full manual (`params/defaults.yaml`) is about 20 kB; a file a hundred
 /// times larger is not a parameter file.
 pub const MAX_FILE_BYTES: usize = 1 << 20;
 /// Deepest nesting accepted (block levels plus flow brackets).

@@ -5,7 +5,7 @@
 //!
 //! Everything else comes from here: the section structs and their defaults, loading and
 //! checking a file or a `-p` value, the echo, the parameter services' descriptions and
-//! read-only flags, the retune rule, `params/ekf.yaml` and `docs/parameters.md` (both
+//! read-only flags, the retune rule, `params/defaults.yaml` and `docs/parameters.md` (both
 //! generated and checked by `tests/parameter_manual.rs`). Checks that relate two
 //! parameters are in `validate.rs`.
 

@@ -106,10 +106,10 @@ ROS arguments (after --ros-args, as rcl parses them):
   -e, --enclave ENCLAVE      accepted and ignored (no DDS security yet)
 
 Example:
-  gnss_ins_node --ros-args --params-file params/ekf.yaml --params-file params/ermakf.yaml \\
+  gnss_ins_node --ros-args --params-file params/defaults.yaml --params-file params/ermakf.yaml \\
       -r __ns:=/vehicle -r imu:=imu/data -p gnss.elevation_mask_deg:=15.0
 
-Every parameter, its unit, range and default: params/ekf.yaml and docs/parameters.md.
+Every parameter, its unit, range and default: params/defaults.yaml and docs/parameters.md.
 ";
 
 /// A command line the node does not accept.
@@ -402,7 +402,7 @@ mod tests {
         let a = p(&[
             "--ros-args",
             "--params-file",
-            "params/ekf.yaml",
+            "params/defaults.yaml",
             "-p",
             "imu.gyro_bias_deg_per_h:=0.3",
             "--params-file",
@@ -426,7 +426,7 @@ mod tests {
         assert_eq!(
             a.parameter_sources,
             vec![
-                file("params/ekf.yaml"),
+                file("params/defaults.yaml"),
                 rule(None, "imu.gyro_bias_deg_per_h", "0.3"),
                 file("params/ermakf.yaml"),
                 rule(None, "filter.variant", "ermakf"),

@@ -50,7 +50,7 @@ pub enum Command {
         /// Input bag: an .mcap file or a rosbag2 directory holding one.
         bag: PathBuf,
         /// Parameter file (ROS 2 params layout, as the node reads it); repeat it to load
-        /// a preset over the manual, e.g. --params params/ekf.yaml --params
+        /// a preset over the manual, e.g. --params params/defaults.yaml --params
         /// params/ermakf.yaml (a later value wins). Defaults when absent.
         #[arg(long)]
         params: Vec<PathBuf>,
@@ -483,4 +483,31 @@ fn render(rows: &[ComparisonRow], format: Format) -> Result<String, String> {
         Format::Csv => format_csv(rows),
         Format::Json => serde_json::to_string_pretty(rows).map_err(|e| e.to_string())? + "\n",
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::Coupling;
+
+    /// `compare --params-dir params` gives every variant the --params files' settings:
+    /// the ekf preset, like the others, changes nothing but its variant (when it was the
+    /// whole manual, the ekf row ran tightly coupled with the default IMU noise while the
+    /// other rows ran the user's files).
+    #[test]
+    fn a_preset_of_params_dir_keeps_what_the_params_files_set() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let base = [
+            root.join("params/defaults.yaml"),
+            root.join("params/ekf_loose.yaml"),
+            root.join("params/imu_consumer_mems.yaml"),
+        ];
+        let from_files = load_config(&base).unwrap();
+        for name in ["ekf", "ermakf"] {
+            let config = variant_config(name, Some(&root.join("params")), &base).unwrap();
+            assert_eq!(config.filter.variant.as_str(), name);
+            assert_eq!(config.filter.coupling, Coupling::Loose, "{name}");
+            assert_eq!(config.imu, from_files.imu, "{name}");
+        }
+    }
 }

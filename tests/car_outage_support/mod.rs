@@ -32,7 +32,7 @@ pub fn outage_distance_m() -> f64 {
 
 pub fn consumer_mems_loose() -> Config {
     config_from_files(&[
-        repo("params/ekf.yaml"),
+        repo("params/defaults.yaml"),
         repo("params/ekf_loose.yaml"),
         repo("params/imu_consumer_mems.yaml"),
     ])

@@ -30,7 +30,7 @@ pub fn static_scenario() -> Scenario {
 /// (`-r`, `-p`) after the preset's.
 pub fn start_node(domain_id: u16, scenario: &Scenario, extra: &[&str]) -> KillOnDrop {
     let spec = &scenario.spec().trajectory;
-    let params = concat!(env!("CARGO_MANIFEST_DIR"), "/params/ekf.yaml");
+    let params = concat!(env!("CARGO_MANIFEST_DIR"), "/params/defaults.yaml");
     let datum = format!(
         "output.datum_llh_deg_m:=[{}, {}, {}]",
         spec.start_lat_deg, spec.start_lon_deg, spec.start_height_m

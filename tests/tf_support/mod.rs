@@ -18,7 +18,7 @@ use adaptive_gnss_ins::tools::simulate::{GNSS_TOPIC, IMU_TOPIC};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 
 /// The preset the TF tests run the filter with (as static_node_support starts the node).
-pub const PRESET: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/params/ekf.yaml");
+pub const PRESET: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/params/defaults.yaml");
 
 /// The base controller's period: 50 Hz.
 pub const CONTROLLER_PERIOD_NS: i64 = 20_000_000;

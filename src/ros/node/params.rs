@@ -581,7 +581,7 @@ mod tests {
     #[test]
     fn every_shipped_preset_loads_over_the_manual() {
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("params");
-        let manual = dir.join("ekf.yaml");
+        let manual = dir.join("defaults.yaml");
         for entry in std::fs::read_dir(&dir).unwrap() {
             let path = entry.unwrap().path();
             config_from_files(&[manual.clone(), path.clone()])
