@@ -24,7 +24,10 @@ struct Track {
 /// Innovation-based noise estimation for every satellite and observable.
 #[derive(Debug, Clone)]
 pub struct InnovationNoise {
-    options: InnovationOptions,
+    /// An empty estimator that every new track copies (its quantile table is computed
+    /// once, not per satellite); None when the options were refused (every verdict is
+    /// then the nominal variance).
+    prototype: Option<InnovationCovarianceEstimator>,
     bounds: VarianceBounds,
     max_gap_s: f64,
     tracks: HashMap<(SatId, Observable), Track>,
@@ -41,7 +44,7 @@ impl InnovationNoise {
             ..InnovationOptions::default()
         };
         Self {
-            options,
+            prototype: InnovationCovarianceEstimator::new(options).ok(),
             bounds: VarianceBounds::new(config),
             max_gap_s: a.max_epoch_gap_s,
             tracks: HashMap::new(),
@@ -53,11 +56,14 @@ impl InnovationNoise {
     pub fn variance(&mut self, t_s: f64, row: &ScalarMeasurement, learn: bool) -> NoiseVerdict {
         let (r_min, r_max) = self.bounds.of(row.observable);
         let new_track = || {
-            InnovationCovarianceEstimator::new(self.options.clone()).map(|estimator| Track {
-                estimator,
-                last_t_s: f64::NEG_INFINITY,
-                last_verdict: None,
-            })
+            self.prototype
+                .clone()
+                .map(|estimator| Track {
+                    estimator,
+                    last_t_s: f64::NEG_INFINITY,
+                    last_verdict: None,
+                })
+                .ok_or(())
         };
         let Some(track) = track_for(&mut self.tracks, row, new_track) else {
             return NoiseVerdict::nominal(row.r_nominal);
