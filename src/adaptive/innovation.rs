@@ -305,15 +305,20 @@ mod tests {
         assert!((est.critical_z() - 1.959_963_984_540_054).abs() < 1e-9);
     }
 
-    #[test]
-    fn alternating_sequence_by_hand() {
-        // ν = ±1 alternating, N = 4: Ĉ = 1, r₁ = −3/4, z = 2·(−3/4) = −1.5: white at 5 %.
-        let opts = InnovationOptions {
+    /// An estimator whose window of four innovations gives its first estimate when full.
+    fn four_sample_estimator() -> InnovationCovarianceEstimator {
+        InnovationCovarianceEstimator::new(InnovationOptions {
             window_size: 4,
             min_samples: 4,
             ..InnovationOptions::default()
-        };
-        let mut est = InnovationCovarianceEstimator::new(opts).unwrap();
+        })
+        .unwrap()
+    }
+
+    #[test]
+    fn alternating_sequence_by_hand() {
+        // ν = ±1 alternating, N = 4: Ĉ = 1, r₁ = −3/4, z = 2·(−3/4) = −1.5: white at 5 %.
+        let mut est = four_sample_estimator();
         for v in [1.0, -1.0, 1.0] {
             assert!(matches!(
                 est.push(v, 0.2).unwrap(),
@@ -334,13 +339,8 @@ mod tests {
     fn resolved_only_when_the_window_exceeds_the_predicted_covariance_significantly() {
         // ν = ±1 alternating over N = 4 (white at 5 %): Ĉ = 1, N Ĉ / H P Hᵀ against
         // χ²₄(0.95) = 9.4877: resolved below H P Hᵀ = 4/9.4877 = 0.4216, not above it.
-        let opts = InnovationOptions {
-            window_size: 4,
-            min_samples: 4,
-            ..InnovationOptions::default()
-        };
         let last = |hph: f64| {
-            let mut est = InnovationCovarianceEstimator::new(opts.clone()).unwrap();
+            let mut est = four_sample_estimator();
             let outcomes: Vec<_> = [1.0, -1.0, 1.0, -1.0]
                 .iter()
                 .map(|&v| est.push(v, hph).unwrap())
