@@ -393,9 +393,10 @@ fn start_position(seed: u64, leveling_s: f64) -> (f64, f64) {
             );
         }
         // The first levelling window is at rest (a standing receiver's Doppler speed
-        // noise does not deny it), and the heading is given: the start follows it.
+        // noise does not deny it), and the heading is given: the start comes at the next
+        // 1 Hz epoch; one denied window would move it a window later.
         assert!(
-            t < leveling_s + 3.0,
+            t < leveling_s + 1.0,
             "seed {seed}: no start by {t} s (a levelling window was denied)"
         );
     }
