@@ -14,10 +14,15 @@
 //!   one), whichever of the two arrives first: over DDS the IMU and GNSS streams have no
 //!   common order, and the result must not depend on it (the live node then equals the
 //!   offline replay of the same data).
-//! - A measurement older than the last IMU sample (late delivery) rolls the filter back to
-//!   the last stored state before it, applies it, and re-integrates the buffered IMU
-//!   samples; one older than `engine.imu_buffer_s` is rejected and counted, and so is one
-//!   more than `engine.imu_buffer_s` ahead of the IMU.
+//! - A measurement older than the last IMU sample (late delivery) rolls the engine back to
+//!   the last kept phase before it (the running filter, or the initializer during the
+//!   start-up), applies it, and re-integrates the buffered IMU samples, so that the result
+//!   is the one of an in-time delivery: only the solutions already published before it
+//!   arrived lacked it. Solutions of a start found in the re-integration are published
+//!   then. Each is counted (`late_measurements` on /diagnostics); one older than
+//!   `engine.imu_buffer_s` is rejected and counted, and so is one more than
+//!   `engine.imu_buffer_s` ahead of the IMU. While the heading bank runs no phase is kept
+//!   (a bank is up to 36 filters): a late measurement then updates the bank as it is.
 //! - Every buffer is bounded by count as well as by time ([`MAX_BUFFERED_IMU_SAMPLES`],
 //!   [`MAX_PENDING_MEASUREMENTS`]), so no input rate or stamp grows memory without bound.
 //! - Wheel speeds (`wheel_odometry.*`, [`wheel_odometry`]) take the measurements' path
@@ -97,7 +102,8 @@ pub use update::GnssFix;
 /// as too old, counted).
 pub const MAX_BUFFERED_IMU_SAMPLES: usize = 10_000;
 
-/// A filter state is kept for roll-backs after every this many IMU steps.
+/// The phase (the filter state, or the initializer) is kept for roll-backs after every
+/// this many IMU steps.
 ///
 /// Choice: 10. A roll-back restarts from the last kept state at or before the late
 /// measurement and re-integrates the samples after it, which it does anyway for the
@@ -124,7 +130,7 @@ pub struct Buffered {
     pub imu_samples: usize,
     /// Steps kept after them (the measurements applied in each).
     pub steps: usize,
-    /// Filter states kept with the steps (one every [`STATE_EVERY_STEPS`]).
+    /// Phases kept with the steps (one every [`STATE_EVERY_STEPS`]).
     pub states: usize,
     /// Measurements waiting for the IMU.
     pub measurements: usize,
@@ -164,13 +170,13 @@ struct Pending {
     reported: bool,
 }
 
-/// One IMU step while running: the measurements applied in it and, every
-/// [`STATE_EVERY_STEPS`], the filter state after it.
+/// One IMU step: the measurements applied in it and, every [`STATE_EVERY_STEPS`], the
+/// phase after it (never a heading bank's).
 #[derive(Debug, Clone)]
 struct Step {
     /// Time of the IMU sample the step ended at (s).
     t_s: f64,
-    state: Option<Box<FilterState>>,
+    kept: Option<Phase>,
     applied: Vec<Measurement>,
 }
 
@@ -195,7 +201,7 @@ pub struct Engine {
     pending: Vec<Pending>,
     last_output_t_s: f64,
     counters: RejectionCounters,
-    /// Solutions are not emitted while re-integrating after a roll-back.
+    /// Re-integrating after a roll-back: the constraint updates are not counted again.
     replaying: bool,
     /// Noise strategy, update scheme and Q scaling of the variant.
     ///
@@ -213,6 +219,8 @@ pub struct Engine {
     monitor: DivergenceMonitor,
     /// Resets after a divergence so far.
     divergence_resets: u64,
+    /// Measurements applied after the IMU had passed their stamp, so far.
+    late_measurements: u64,
     fix_outliers: FixOutliers,
     /// Time of the last divergence while the filter has not started again since.
     diverged_at_t_s: Option<f64>,
@@ -223,7 +231,7 @@ impl Engine {
         let process_noise = process_noise(&config);
         Self {
             adaptation: Adaptation::new(&config),
-            standstill: StandstillDetector::default(),
+            standstill: StandstillDetector::new(config.engine.imu_buffer_s),
             config,
             process_noise,
             phase: Phase::Initializing(Box::default()),
@@ -237,6 +245,7 @@ impl Engine {
             constraints: Constraints::default(),
             monitor: DivergenceMonitor::default(),
             divergence_resets: 0,
+            late_measurements: 0,
             fix_outliers: FixOutliers::default(),
             diverged_at_t_s: None,
         }
@@ -264,6 +273,13 @@ impl Engine {
     /// Resets after a divergence from GNSS so far.
     pub fn divergence_resets(&self) -> u64 {
         self.divergence_resets
+    }
+
+    /// Measurements that arrived after the IMU had passed their stamp and were applied by
+    /// a roll-back (or, while the heading bank runs, to the bank as it was), so far: the
+    /// solutions published in between lacked them.
+    pub fn late_measurements(&self) -> u64 {
+        self.late_measurements
     }
 
     /// Time of the divergence the engine is recovering from: set by a divergence reset,
@@ -295,7 +311,7 @@ impl Engine {
         Buffered {
             imu_samples: self.imu.len(),
             steps: self.history.len(),
-            states: self.history.iter().filter(|s| s.state.is_some()).count(),
+            states: self.history.iter().filter(|s| s.kept.is_some()).count(),
             measurements: self.pending.len(),
             standstill_samples: self.standstill.sample_count(),
         }
@@ -515,35 +531,46 @@ impl Engine {
         if t < oldest {
             return Err(self.counters.reject(RejectionReason::MeasurementTooOld, t));
         }
+        // Roll back to the last kept phase at or before t.
+        let keep = self
+            .history
+            .iter()
+            .rposition(|s| s.t_s <= t && s.kept.is_some());
         let mut out = Vec::new();
-        match &self.phase {
-            Phase::Initializing(_) | Phase::Aligning(_) => {
-                // Start-up needs no exact alignment: try it now, then re-integrate.
-                self.enqueue(m, false);
-                self.replay_from(None, &mut out);
+        match (&self.phase, keep) {
+            (Phase::Aligning(_), _) => {
+                // Choice: the bank keeps no phase (see Step), and re-running one is up to
+                // 36 filters over the buffer: it takes the measurement as it is now, as a
+                // late measurement without a roll-back would be.
+                self.late_measurements += 1;
+                let newest = *self.imu.back().expect("an IMU sample, as last_t");
+                let p = Pending {
+                    measurement: m,
+                    reported: false,
+                };
+                self.apply_measurement(&p, &newest, &mut out);
+                if let Some(step) = self.history.back_mut() {
+                    step.applied.push(p.measurement);
+                }
             }
-            Phase::Running(_) => {
-                // Roll back to the last kept state at or before t.
-                let keep = self
-                    .history
-                    .iter()
-                    .rposition(|s| s.t_s <= t && s.state.is_some());
-                match keep {
-                    Some(k) => {
-                        self.enqueue(m, false);
-                        let undone: Vec<Step> = self.history.drain(k + 1..).collect();
-                        for step in undone {
-                            for a in step.applied {
-                                self.enqueue(a, true);
-                            }
-                        }
-                        let start = self.history.back().and_then(|s| s.state.as_deref());
-                        self.replay_from(start.cloned(), &mut out);
-                    }
-                    None => {
-                        return Err(self.counters.reject(RejectionReason::MeasurementTooOld, t));
+            (_, Some(k)) => {
+                self.late_measurements += 1;
+                self.enqueue(m, false);
+                let undone: Vec<Step> = self.history.drain(k + 1..).collect();
+                for step in undone {
+                    for a in step.applied {
+                        self.enqueue(a, true);
                     }
                 }
+                let kept = &self.history[k];
+                let from_t_s = kept.t_s;
+                if let Some(phase) = kept.kept.clone() {
+                    self.phase = phase;
+                }
+                self.replay_after(from_t_s, &mut out);
+            }
+            (_, None) => {
+                return Err(self.counters.reject(RejectionReason::MeasurementTooOld, t));
             }
         }
         Ok(out)
@@ -566,17 +593,13 @@ impl Engine {
         );
     }
 
-    /// Re-integrates the buffered IMU samples after `start` (or all of them when the
-    /// filter is initializing), applying the pending measurements on the way.
-    fn replay_from(&mut self, start: Option<FilterState>, out: &mut Vec<Output>) {
-        let from_t = start.as_ref().map_or(f64::NEG_INFINITY, |s| s.last_imu.t_s);
-        if let Some(state) = start {
-            self.phase = Phase::Running(Box::new(state));
-        }
+    /// Re-integrates the buffered IMU samples after `from_t_s` (the restored phase's
+    /// time), applying the pending measurements on the way.
+    fn replay_after(&mut self, from_t_s: f64, out: &mut Vec<Output>) {
         let samples: Vec<ImuSample> = self
             .imu
             .iter()
-            .filter(|s| s.t_s > from_t)
+            .filter(|s| s.t_s > from_t_s)
             .copied()
             .collect();
         self.replaying = true;
@@ -610,6 +633,7 @@ impl Engine {
                         self.counters.reject(RejectionReason::ImuStepFailed, s.t_s);
                         let reset = self.reset(s.t_s, ResetReason::Diverged);
                         out.push(reset);
+                        return;
                     }
                 }
             }
@@ -637,22 +661,23 @@ impl Engine {
                         self.counters.reject(RejectionReason::UpdateFailed, s.t_s);
                     }
                 }
+                // A re-integration after a roll-back publishes only what was not yet
+                // published: the solutions of a start it found.
                 let t_s = state.last_imu.t_s;
-                if !self.replaying
-                    && output_due(self.config.output.rate_hz, &mut self.last_output_t_s, t_s)
-                {
+                if output_due(self.config.output.rate_hz, &mut self.last_output_t_s, t_s) {
                     out.push(Output::Solution(Box::new(state.solution())));
                 }
-                let keep = (self.history.iter().rev())
-                    .take(STATE_EVERY_STEPS - 1)
-                    .all(|s| s.state.is_none());
-                self.history.push_back(Step {
-                    t_s,
-                    state: keep.then(|| state.clone()),
-                    applied,
-                });
             }
         }
+        let keep = !matches!(self.phase, Phase::Aligning(_))
+            && (self.history.iter().rev())
+                .take(STATE_EVERY_STEPS - 1)
+                .all(|s| s.kept.is_none());
+        self.history.push_back(Step {
+            t_s: s.t_s,
+            kept: keep.then(|| self.phase.clone()),
+            applied,
+        });
     }
 
     /// Propagates to the measurement's time (running) or tries to start (initializing),
@@ -747,9 +772,10 @@ impl Engine {
 }
 
 /// Whether a solution at `t_s` is due at `rate_hz` (0: every IMU sample) after the last one
-/// at `last_output_t_s`, which it then becomes.
+/// at `last_output_t_s`, which it then becomes; never one at or before it (published
+/// already, or passed over).
 fn output_due(rate_hz: f64, last_output_t_s: &mut f64, t_s: f64) -> bool {
-    if rate_hz > 0.0 && t_s - *last_output_t_s < 1.0 / rate_hz - 1e-9 {
+    if t_s <= *last_output_t_s || rate_hz > 0.0 && t_s - *last_output_t_s < 1.0 / rate_hz - 1e-9 {
         return false;
     }
     *last_output_t_s = t_s;

@@ -152,13 +152,25 @@ impl MotionStatistics {
     }
 }
 
-/// The IMU samples of the last [`WINDOW_S`].
+/// The IMU samples of the last [`WINDOW_S`], and of the `history_s` before it: a late
+/// measurement's start-up asks the window that ended at its time
+/// ([`StandstillDetector::window_ending_at`]), as it would have in time.
 #[derive(Debug, Clone, Default)]
 pub struct StandstillDetector {
     samples: VecDeque<ImuSample>,
+    history_s: f64,
 }
 
 impl StandstillDetector {
+    /// A detector that keeps `history_s` (the engine's `engine.imu_buffer_s`) of samples
+    /// before its window.
+    pub fn new(history_s: f64) -> Self {
+        Self {
+            samples: VecDeque::new(),
+            history_s,
+        }
+    }
+
     /// Adds a body-frame sample; one older than the newest (the time went back, as when a
     /// bag plays in a loop) starts the window again: the old time line's samples would
     /// stay in front, never older than the new ones by the window's length, and the
@@ -171,14 +183,14 @@ impl StandstillDetector {
         while self
             .samples
             .front()
-            .is_some_and(|old| old.t_s < s.t_s - WINDOW_S)
+            .is_some_and(|old| old.t_s < s.t_s - WINDOW_S - self.history_s)
             || self.samples.len() > MAX_WINDOW_SAMPLES
         {
             self.samples.pop_front();
         }
     }
 
-    /// The samples in the window.
+    /// The samples kept (the window and the history before it).
     pub fn sample_count(&self) -> usize {
         self.samples.len()
     }
@@ -188,11 +200,25 @@ impl StandstillDetector {
         self.samples.clear();
     }
 
-    /// The statistics of the window; its count is 0 until the window spans most of
-    /// [`WINDOW_S`] (a verdict on less would be one on a few samples).
+    /// The statistics of the window that ends at the newest sample (see
+    /// [`StandstillDetector::window_ending_at`]).
     pub fn window(&self) -> MotionStatistics {
+        self.samples
+            .back()
+            .map_or_else(MotionStatistics::default, |s| self.window_ending_at(s.t_s))
+    }
+
+    /// The statistics of the samples of the [`WINDOW_S`] that ends at `end_t_s` (at most
+    /// [`MAX_WINDOW_SAMPLES`], the newest); its count is 0 unless they span most of
+    /// [`WINDOW_S`] (a verdict on less would be one on a few samples).
+    pub fn window_ending_at(&self, end_t_s: f64) -> MotionStatistics {
+        let end = self.samples.partition_point(|s| s.t_s <= end_t_s);
+        let start = self
+            .samples
+            .partition_point(|s| s.t_s < end_t_s - WINDOW_S)
+            .max(end.saturating_sub(MAX_WINDOW_SAMPLES));
         let mut stats = MotionStatistics::default();
-        for s in &self.samples {
+        for s in self.samples.range(start..end.max(start)) {
             stats.push(s);
         }
         // Choice: 90 % of the window, so that sample jitter does not delay every verdict.

@@ -23,7 +23,9 @@ impl Engine {
         let Phase::Initializing(init) = &mut self.phase else {
             return;
         };
-        let recent = self.standstill.window();
+        // The window of `next` (the first sample after the measurement), as when it
+        // arrived in time, also after a roll-back.
+        let recent = self.standstill.window_ending_at(next.t_s);
         let started = match m {
             Measurement::Gnss(e) => init.try_gnss(e, &self.config, &recent),
             Measurement::Fix(f) => init.try_fix(f, &self.config, &recent),

@@ -54,6 +54,89 @@ pub fn largest_difference_of_runs(live: &[Odometry], offline: &[Odometry], what:
         .fold(0.0_f64, f64::max)
 }
 
+/// Solutions equal within this are the same.
+pub const SAME: f64 = 1e-9;
+
+/// A live node's solutions against the replay's of the same data.
+#[derive(Debug)]
+pub struct LiveAgainstReplay {
+    pub solutions: usize,
+    /// Runs of solutions that differ: each published before a late measurement arrived.
+    pub late_runs: usize,
+    /// Largest difference in them.
+    pub worst_late: f64,
+    /// Largest difference elsewhere (at most [`SAME`]).
+    pub worst_in_time: f64,
+}
+
+/// Compares a live node's solutions with the replay's of the same data (same stamps
+/// asserted). Over DDS the IMU and a measurement have no common order: one that arrived
+/// after the IMU passed its stamp was applied by a roll-back, so only the solutions the
+/// node published in between lacked it. Asserts that every solution differing by more
+/// than [`SAME`] is such: it lies in a run that begins at the first solution after a
+/// measurement's stamp (`measurement_t_s`, sorted) and ends before the next measurement's,
+/// and there are at most `late` runs (the node's `late_measurements`).
+pub fn assert_live_matches_replay(
+    live: &[Odometry],
+    offline: &[Odometry],
+    measurement_t_s: &[f64],
+    late: u64,
+    what: &str,
+) -> LiveAgainstReplay {
+    assert_eq!(live.len(), offline.len(), "Odometry messages: {what}");
+    let seconds =
+        |o: &Odometry| f64::from(o.header.stamp.sec) + f64::from(o.header.stamp.nanosec) * 1e-9;
+    let mut result = LiveAgainstReplay {
+        solutions: live.len(),
+        late_runs: 0,
+        worst_late: 0.0,
+        worst_in_time: 0.0,
+    };
+    // The stamp the current run must end at or before.
+    let mut run_ends_by: Option<f64> = None;
+    for (k, (a, b)) in live.iter().zip(offline).enumerate() {
+        assert_eq!(a.header.stamp, b.header.stamp, "{what}");
+        let d = largest_difference(a, b);
+        let t = seconds(a);
+        if d <= SAME {
+            result.worst_in_time = result.worst_in_time.max(d);
+            run_ends_by = None;
+            continue;
+        }
+        result.worst_late = result.worst_late.max(d);
+        if let Some(end) = run_ends_by {
+            assert!(
+                t <= end,
+                "{what}: solution at {t} differs by {d}, after the next measurement at {end}"
+            );
+            continue;
+        }
+        let before = if k == 0 {
+            f64::NEG_INFINITY
+        } else {
+            seconds(&live[k - 1])
+        };
+        let at = measurement_t_s.partition_point(|&m| m < before);
+        assert!(
+            measurement_t_s.get(at).is_some_and(|&m| m < t),
+            "{what}: solution at {t} differs by {d}, and no measurement is stamped in [{before}, {t})"
+        );
+        result.late_runs += 1;
+        run_ends_by = Some(
+            measurement_t_s
+                .get(at + 1)
+                .copied()
+                .unwrap_or(f64::INFINITY),
+        );
+    }
+    assert!(
+        result.late_runs as u64 <= late,
+        "{what}: {} runs of differing solutions, {late} late measurements: {result:?}",
+        result.late_runs
+    );
+    result
+}
+
 /// Every number of an Odometry: pose, orientation, twist and both covariances.
 pub fn numbers(o: &Odometry) -> Vec<f64> {
     let (p, t) = (&o.pose.pose, &o.twist.twist);

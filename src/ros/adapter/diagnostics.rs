@@ -10,7 +10,7 @@ use super::RosAdapter;
 impl RosAdapter {
     /// The /diagnostics report at `stamp`: input counts, constraint updates by kind, fix
     /// positions and velocities deweighted as outliers, rejections by reason, resets after
-    /// a divergence, with `gnss.tdcp` the phase changes used and left out by reason, phase
+    /// a divergence, measurements applied late (by a roll-back), with `gnss.tdcp` the phase changes used and left out by reason, phase
     /// and, in `tf_mode` `map_to_odom` the `odom → base` transforms heard and the Odometry
     /// messages without a `map → odom`, once running, the filter's 3D position sigma
     /// (level ERROR when it is not finite) and the scale factors it estimates; level ERROR
@@ -62,6 +62,10 @@ impl RosAdapter {
         values.push(key_value(
             "divergence_resets",
             self.engine.divergence_resets().to_string(),
+        ));
+        values.push(key_value(
+            "late_measurements",
+            self.engine.late_measurements().to_string(),
         ));
         let (level, message) = match (self.engine.state(), self.engine.diverged_at_t_s()) {
             (None, Some(t_s)) => (
