@@ -206,8 +206,9 @@ fn late_gnss_epoch_within_the_buffer_is_applied_by_rolling_back() {
     let report = report.expect("the late epoch is reported");
     assert!((report.t_s - 9.655).abs() < 1e-12);
     assert!(report.measurements_used > 8);
-    // Rolled-back integration emits no stale solutions.
+    // Rolled-back integration emits no stale solutions, and counts the late epoch.
     assert!(!out.iter().any(|o| matches!(o, Output::Solution(_))));
+    assert_eq!(run.engine.late_measurements(), 1);
     run.run(10.0, 60.0);
     run.assert_position_ok();
 }

@@ -222,6 +222,8 @@ pub struct Engine {
     /// Measurements applied after the IMU had passed their stamp, so far.
     late_measurements: u64,
     fix_outliers: FixOutliers,
+    /// The start since the last reset was reported.
+    start_reported: bool,
     /// Time of the last divergence while the filter has not started again since.
     diverged_at_t_s: Option<f64>,
 }
@@ -246,6 +248,7 @@ impl Engine {
             monitor: DivergenceMonitor::default(),
             divergence_resets: 0,
             late_measurements: 0,
+            start_reported: false,
             fix_outliers: FixOutliers::default(),
             diverged_at_t_s: None,
         }
@@ -356,6 +359,7 @@ impl Engine {
         self.constraints.clear();
         self.standstill.clear();
         self.last_output_t_s = f64::NEG_INFINITY;
+        self.start_reported = false;
         Output::Status(StatusEvent::Reset { t_s, reason })
     }
 
@@ -689,8 +693,8 @@ impl Engine {
             self.constraints.note_fix(f);
         }
         match &mut self.phase {
-            Phase::Initializing(_) => self.try_start(&p.measurement, next, report, out),
-            Phase::Aligning(_) => self.update_bank(&p.measurement, next, report, out),
+            Phase::Initializing(_) => self.try_start(&p.measurement, next, out),
+            Phase::Aligning(_) => self.update_bank(&p.measurement, next, out),
             Phase::Running(state) => {
                 if state.last_imu.t_s < t {
                     let at_t = interpolate(&state.last_imu, next, t);

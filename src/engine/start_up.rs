@@ -13,13 +13,7 @@ use crate::ins::ImuSample;
 impl Engine {
     /// Tries to start from the GNSS measurement `m` (the sample after it is `next`); on
     /// success the filter runs, or the heading bank does.
-    pub(super) fn try_start(
-        &mut self,
-        m: &Measurement,
-        next: &ImuSample,
-        report: bool,
-        out: &mut Vec<Output>,
-    ) {
+    pub(super) fn try_start(&mut self, m: &Measurement, next: &ImuSample, out: &mut Vec<Output>) {
         let Phase::Initializing(init) = &mut self.phase else {
             return;
         };
@@ -48,7 +42,7 @@ impl Engine {
             )));
             return;
         }
-        self.start_running(state, initial.heading_from_motion, report, out);
+        self.start_running(state, initial.heading_from_motion, out);
     }
 
     /// The filter state of a start at `t` (between the buffered samples and `next`).
@@ -86,13 +80,15 @@ impl Engine {
         &mut self,
         state: FilterState,
         heading_from_motion: bool,
-        report: bool,
         out: &mut Vec<Output>,
     ) {
         let t_s = state.nav.t_s;
         self.phase = Phase::Running(Box::new(state));
         self.diverged_at_t_s = None;
-        if report {
+        // Reported once: a roll-back may start the filter again, at the same time or (the
+        // late measurement completing an earlier start) before.
+        if !self.start_reported {
+            self.start_reported = true;
             out.push(Output::Status(StatusEvent::Initialized {
                 t_s,
                 heading_from_motion,
@@ -102,13 +98,7 @@ impl Engine {
 
     /// Updates every hypothesis of the heading bank with `m`; starts the filter once the
     /// bank has decided.
-    pub(super) fn update_bank(
-        &mut self,
-        m: &Measurement,
-        next: &ImuSample,
-        report: bool,
-        out: &mut Vec<Output>,
-    ) {
+    pub(super) fn update_bank(&mut self, m: &Measurement, next: &ImuSample, out: &mut Vec<Output>) {
         let Phase::Aligning(bank) = &mut self.phase else {
             return;
         };
@@ -139,7 +129,7 @@ impl Engine {
             return;
         }
         if let Some(state) = bank.resolved(t) {
-            self.start_running(state, true, report, out);
+            self.start_running(state, true, out);
         }
     }
 }
