@@ -18,8 +18,9 @@
 //! same).
 
 use adaptive_gnss_ins::config::{Config, Coupling, FilterVariant};
-use adaptive_gnss_ins::engine::{Engine, FilterState, Output, ResetReason, StatusEvent};
+use adaptive_gnss_ins::engine::{Engine, FilterState, GnssFix, Output, ResetReason, StatusEvent};
 use adaptive_gnss_ins::eval;
+use adaptive_gnss_ins::gnss::GnssEpoch;
 use adaptive_gnss_ins::ins::ImuSample;
 use adaptive_gnss_ins::sim::constellation::GpsConstellation;
 use adaptive_gnss_ins::sim::{ImuErrorModel, ImuErrorSpec, Trajectory};
@@ -74,6 +75,12 @@ struct Run {
     epochs: Vec<(f64, f64, f64)>,
 }
 
+/// A GNSS input of either coupling.
+enum GnssInput {
+    Epoch(GnssEpoch),
+    Fix(GnssFix),
+}
+
 /// What goes wrong on the drive.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Fault {
@@ -89,12 +96,23 @@ enum Fault {
 }
 
 fn run(variant: FilterVariant, coupling: Coupling, fault: Fault) -> Run {
+    run_late(variant, coupling, fault, 0)
+}
+
+/// [`run`] with every GNSS input delivered `gnss_delay_samples` IMU samples late.
+fn run_late(
+    variant: FilterVariant,
+    coupling: Coupling,
+    fault: Fault,
+    gnss_delay_samples: usize,
+) -> Run {
     run_with(
         variant,
         coupling,
         fault,
         &ImuErrorSpec::default(),
         Config::default(),
+        gnss_delay_samples,
     )
 }
 
@@ -104,6 +122,7 @@ fn run_with(
     fault: Fault,
     imu_spec: &ImuErrorSpec,
     mut config: Config,
+    gnss_delay_samples: usize,
 ) -> Run {
     let name = format!("{variant:?} {coupling:?} fault {fault:?}");
     let trajectory = Trajectory::new(&drive(1)).unwrap();
@@ -125,7 +144,9 @@ fn run_with(
         worst_nees: 0.0,
         epochs: Vec::new(),
     };
-    for truth in trajectory.samples(imu_rate_hz).unwrap() {
+    // The GNSS input waiting for its delivery: the sample it is due after, and the input.
+    let mut held: Option<(usize, GnssInput)> = None;
+    for (k, truth) in trajectory.samples(imu_rate_hz).unwrap().enumerate() {
         let t = truth.nav.t_s;
         let in_outage =
             fault == Fault::AccelDuringOutage && (OUTAGE_FROM_S..OUTAGE_TO_S).contains(&t);
@@ -145,13 +166,19 @@ fn run_with(
         let mut out = engine.push_imu(&measured).unwrap();
         let epoch_due = (t - t.round()).abs() < 1e-9 && !in_outage;
         if epoch_due {
-            match coupling {
+            let input = match coupling {
                 Coupling::Tight => {
-                    let epoch = drive_epoch(&constellation, &mut rng, &truth.nav);
-                    out.extend(engine.push_gnss(epoch).unwrap());
+                    GnssInput::Epoch(drive_epoch(&constellation, &mut rng, &truth.nav))
                 }
-                Coupling::Loose => out.extend(engine.push_fix(fixes.fix(&truth.nav)).unwrap()),
-            }
+                Coupling::Loose => GnssInput::Fix(fixes.fix(&truth.nav)),
+            };
+            held = Some((k + gnss_delay_samples, input));
+        }
+        if let Some((_, input)) = held.take_if(|(due, _)| *due <= k) {
+            out.extend(match input {
+                GnssInput::Epoch(epoch) => engine.push_gnss(epoch).unwrap(),
+                GnssInput::Fix(fix) => engine.push_fix(fix).unwrap(),
+            });
         }
         for o in &out {
             match o {
@@ -208,8 +235,8 @@ fn run_with(
     result
 }
 
-fn detects_resets_and_recovers(variant: FilterVariant, coupling: Coupling) {
-    let r = run(variant, coupling, Fault::AccelDuringOutage);
+fn detects_resets_and_recovers(variant: FilterVariant, coupling: Coupling, delay_samples: usize) {
+    let r = run_late(variant, coupling, Fault::AccelDuringOutage, delay_samples);
     assert!(
         r.worst_error_before_reset_m > 300.0,
         "{variant:?} {coupling:?}: the fault was not a divergence: {r:?}"
@@ -227,14 +254,23 @@ fn detects_resets_and_recovers(variant: FilterVariant, coupling: Coupling) {
 #[test]
 fn a_divergence_is_detected_within_5_s_reset_and_recovered_loosely_coupled() {
     for variant in [FilterVariant::Ekf, FilterVariant::Iarf] {
-        detects_resets_and_recovers(variant, Coupling::Loose);
+        detects_resets_and_recovers(variant, Coupling::Loose, 0);
     }
 }
 
 #[test]
 fn a_divergence_is_detected_within_5_s_reset_and_recovered_tightly_coupled() {
     for variant in [FilterVariant::Ekf, FilterVariant::Iarf] {
-        detects_resets_and_recovers(variant, Coupling::Tight);
+        detects_resets_and_recovers(variant, Coupling::Tight, 0);
+    }
+}
+
+/// The same with every GNSS input five IMU samples late (as DDS may deliver it): the
+/// reset comes from a late input, in the re-integration after its roll-back.
+#[test]
+fn a_divergence_seen_in_late_gnss_is_detected_reset_and_recovered() {
+    for coupling in [Coupling::Loose, Coupling::Tight] {
+        detects_resets_and_recovers(FilterVariant::Ekf, coupling, 5);
     }
 }
 
@@ -308,6 +344,7 @@ fn gyro_fault_is_detected_reset_and_recovered(coupling: Coupling, config: Config
             Fault::GyroBiasTenfold,
             &consumer_mems_imu(),
             config.clone(),
+            0,
         );
         let [reset_t_s] = r.resets.as_slice() else {
             panic!("{variant:?}: one reset expected: {r:?}");

@@ -2,7 +2,7 @@
 //! measurement that arrives after the IMU passed its stamp rolls the engine back (during
 //! the start-up too), so the adapter publishes the solutions of an in-time delivery but for
 //! those it published before the measurement arrived, and publishes them all (a start
-//! found late included). Driven through the adapter, as the node and `gnss_ins replay`
+//! found late included), with every epoch's report once. Driven through the adapter, as the node and `gnss_ins replay`
 //! drive it, on the fixture's scenario: tightly coupled, and loosely coupled with receiver
 //! velocities (a fix waits for its velocity).
 
@@ -39,18 +39,35 @@ fn fixture_messages(velocity: bool) -> Vec<InputMessage> {
         .collect()
 }
 
-/// The Odometry the adapter publishes for `messages`, and its late measurements.
-fn run(messages: &[InputMessage], config: &Config) -> (Vec<Odometry>, u64) {
+/// What the adapter published for some messages, and its count of late ones.
+struct Run {
+    odometry: Vec<Odometry>,
+    /// Epoch reports (`~/noise_estimates`).
+    epochs: usize,
+    late_measurements: u64,
+}
+
+/// What the adapter publishes for `messages`.
+fn run(messages: &[InputMessage], config: &Config) -> Run {
     let mut adapter = RosAdapter::new(config.clone(), OutputFrames::default());
-    let mut odometry = Vec::new();
+    let (mut odometry, mut epochs) = (Vec::new(), 0);
     for m in messages {
         for published in adapter.on_message(m) {
-            if let Published::Solution(s) = published {
-                odometry.push(s.messages.expect("framed").odometry.clone());
+            match published {
+                Published::Solution(s) => {
+                    odometry.push(s.messages.expect("framed").odometry.clone());
+                }
+                Published::Epoch(_) => epochs += 1,
+                Published::NoFix(_) => {}
             }
         }
     }
-    (odometry, adapter.engine().late_measurements())
+    let late_measurements = adapter.engine().late_measurements();
+    Run {
+        odometry,
+        epochs,
+        late_measurements,
+    }
 }
 
 /// `messages` with every GNSS message (all but the IMU) delivered after `delay` more IMU
@@ -92,16 +109,17 @@ fn measurement_stamps_s(messages: &[InputMessage], config: &Config) -> Vec<f64> 
 
 fn check(config: &Config, velocity: bool) {
     let messages = fixture_messages(velocity);
-    let (in_time, late_in_time) = run(&messages, config);
-    assert_eq!(late_in_time, 0, "the bag's order is the IMU's");
-    assert!(in_time.len() > 2000, "{} solutions", in_time.len());
+    let in_time = run(&messages, config);
+    assert_eq!(in_time.late_measurements, 0, "the bag's order is the IMU's");
+    let solutions = &in_time.odometry;
+    assert!(solutions.len() > 2000, "{} solutions", solutions.len());
     let stamps = measurement_stamps_s(&messages, config);
     let epochs = stamps.len() as u64;
     // The epochs a solution follows (the last one, at the last IMU sample, none).
     let solution_s = |o: &Odometry| time_to_seconds(&o.header.stamp).unwrap();
     let (first_s, last_s) = (
-        solution_s(&in_time[0]),
-        solution_s(&in_time[in_time.len() - 1]),
+        solution_s(&solutions[0]),
+        solution_s(&solutions[solutions.len() - 1]),
     );
     let epochs_running = stamps
         .iter()
@@ -109,21 +127,24 @@ fn check(config: &Config, velocity: bool) {
         .count();
     // One sample, a few, and 0.2 s of a 100 Hz IMU.
     for delay in [1, 7, 20] {
-        let (late, late_count) = run(&delayed(&messages, delay), config);
+        let late = run(&delayed(&messages, delay), config);
+        let count = late.late_measurements;
         let what = format!("GNSS {delay} IMU samples late vs in time");
-        let compared = assert_live_matches_replay(&late, &in_time, &stamps, late_count, &what);
-        println!("{what}: {late_count} late measurements, {compared:?}");
+        let compared = assert_live_matches_replay(&late.odometry, solutions, &stamps, count, &what);
+        println!("{what}: {count} late measurements, {compared:?}");
         // Every epoch after the first IMU sample came late, the starting one among them,
-        // and each lacked in the solutions published before it came.
+        // and each lacked in the solutions published before it came; each is reported
+        // once, as in time.
         assert!(
-            late_count + 1 >= epochs && late_count <= epochs,
-            "{late_count} of {epochs}"
+            count + 1 >= epochs && count <= epochs,
+            "{count} of {epochs}"
         );
         assert_eq!(compared.late_runs, epochs_running, "{compared:?}");
         assert!(
             compared.worst_late > 0.01,
             "the test sees a late epoch: {compared:?}"
         );
+        assert_eq!(late.epochs, in_time.epochs, "{what}: epoch reports");
     }
 }
 

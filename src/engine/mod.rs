@@ -21,8 +21,10 @@
 //!   arrived lacked it. Solutions of a start found in the re-integration are published
 //!   then. Each is counted (`late_measurements` on /diagnostics); one older than
 //!   `engine.imu_buffer_s` is rejected and counted, and so is one more than
-//!   `engine.imu_buffer_s` ahead of the IMU. While the heading bank runs no phase is kept
-//!   (a bank is up to 36 filters): a late measurement then updates the bank as it is.
+//!   `engine.imu_buffer_s` ahead of the IMU. No roll-back reaches into the heading bank (a
+//!   bank is up to 36 filters, kept in no step): a late measurement older than the bank's
+//!   end updates the bank, or the filter it started, as it is. A reset during a
+//!   re-integration takes the samples after it as new ones.
 //! - Every buffer is bounded by count as well as by time ([`MAX_BUFFERED_IMU_SAMPLES`],
 //!   [`MAX_PENDING_MEASUREMENTS`]), so no input rate or stamp grows memory without bound.
 //! - Wheel speeds (`wheel_odometry.*`, [`wheel_odometry`]) take the measurements' path
@@ -171,13 +173,35 @@ struct Pending {
 }
 
 /// One IMU step: the measurements applied in it and, every [`STATE_EVERY_STEPS`], the
-/// phase after it (never a heading bank's).
+/// phase after it.
 #[derive(Debug, Clone)]
 struct Step {
     /// Time of the IMU sample the step ended at (s).
     t_s: f64,
-    kept: Option<Phase>,
-    applied: Vec<Measurement>,
+    kept: Kept,
+    /// The measurements applied, each with whether it was reported (applied to the
+    /// running filter, which reported it).
+    applied: Vec<Pending>,
+}
+
+/// What a step keeps for roll-backs.
+#[derive(Debug, Clone)]
+enum Kept {
+    Nothing,
+    /// The phase after the step: the initializer, or the running filter.
+    Phase(Phase),
+    /// A step of the heading bank: no roll-back reaches behind it.
+    Bank,
+}
+
+/// Where a late measurement goes.
+enum LateTarget {
+    /// Roll back to the phase kept in this step.
+    Step(usize),
+    /// A heading bank ran since its stamp: to what runs now, as it is.
+    AsItIs,
+    /// Older than every kept phase.
+    TooOld,
 }
 
 #[derive(Debug, Clone)]
@@ -314,7 +338,9 @@ impl Engine {
         Buffered {
             imu_samples: self.imu.len(),
             steps: self.history.len(),
-            states: self.history.iter().filter(|s| s.kept.is_some()).count(),
+            states: (self.history.iter())
+                .filter(|s| matches!(s.kept, Kept::Phase(_)))
+                .count(),
             measurements: self.pending.len(),
             standstill_samples: self.standstill.sample_count(),
         }
@@ -408,6 +434,12 @@ impl Engine {
                 out.push(self.reset(body.t_s, ResetReason::ImuGap));
             }
         }
+        self.take_body_sample(body, &mut out);
+        Ok(out)
+    }
+
+    /// Buffers the screened body-frame sample `body` and processes everything up to it.
+    fn take_body_sample(&mut self, body: ImuSample, out: &mut Vec<Output>) {
         self.standstill.push(&body);
         self.constraints
             .push_window(body.t_s, &self.standstill, &self.config);
@@ -425,8 +457,7 @@ impl Engine {
         let stale = self.history.iter().take_while(|s| s.t_s < horizon).count();
         let over = (self.history.len() + 1).saturating_sub(MAX_BUFFERED_IMU_SAMPLES);
         self.history.drain(..stale.max(over));
-        self.advance(&body, &mut out);
-        Ok(out)
+        self.advance(&body, out);
     }
 
     /// Feeds one GNSS epoch (tightly coupled).
@@ -516,7 +547,7 @@ impl Engine {
             || self
                 .history
                 .iter()
-                .any(|s| s.applied.iter().any(|a| a.duplicates(&m)))
+                .any(|s| s.applied.iter().any(|a| a.measurement.duplicates(&m)))
         {
             return Err(self
                 .counters
@@ -535,45 +566,43 @@ impl Engine {
         if t < oldest {
             return Err(self.counters.reject(RejectionReason::MeasurementTooOld, t));
         }
-        // Roll back to the last kept phase at or before t.
-        let keep = self
-            .history
-            .iter()
-            .rposition(|s| s.t_s <= t && s.kept.is_some());
         let mut out = Vec::new();
-        match (&self.phase, keep) {
-            (Phase::Aligning(_), _) => {
-                // Choice: the bank keeps no phase (see Step), and re-running one is up to
-                // 36 filters over the buffer: it takes the measurement as it is now, as a
-                // late measurement without a roll-back would be.
+        match self.late_target(t) {
+            LateTarget::Step(k) => {
+                self.late_measurements += 1;
+                self.enqueue(m, false);
+                let undone: Vec<Step> = self.history.drain(k + 1..).collect();
+                for step in undone {
+                    for a in step.applied {
+                        self.enqueue(a.measurement, a.reported);
+                    }
+                }
+                let kept = &self.history[k];
+                let from_t_s = kept.t_s;
+                if let Kept::Phase(phase) = &kept.kept {
+                    self.phase = phase.clone();
+                }
+                self.replay_after(from_t_s, &mut out);
+            }
+            LateTarget::AsItIs => {
+                // Choice: re-running a bank is up to 36 filters over the buffer; the
+                // measurement is taken as it is now, as a late one without a roll-back
+                // would be.
                 self.late_measurements += 1;
                 let newest = *self.imu.back().expect("an IMU sample, as last_t");
                 let p = Pending {
                     measurement: m,
                     reported: false,
                 };
-                self.apply_measurement(&p, &newest, &mut out);
+                let reported = self.apply_measurement(&p, &newest, &mut out);
                 if let Some(step) = self.history.back_mut() {
-                    step.applied.push(p.measurement);
+                    step.applied.push(Pending {
+                        measurement: p.measurement,
+                        reported,
+                    });
                 }
             }
-            (_, Some(k)) => {
-                self.late_measurements += 1;
-                self.enqueue(m, false);
-                let undone: Vec<Step> = self.history.drain(k + 1..).collect();
-                for step in undone {
-                    for a in step.applied {
-                        self.enqueue(a, true);
-                    }
-                }
-                let kept = &self.history[k];
-                let from_t_s = kept.t_s;
-                if let Some(phase) = kept.kept.clone() {
-                    self.phase = phase;
-                }
-                self.replay_after(from_t_s, &mut out);
-            }
-            (_, None) => {
+            LateTarget::TooOld => {
                 return Err(self.counters.reject(RejectionReason::MeasurementTooOld, t));
             }
         }
@@ -597,8 +626,23 @@ impl Engine {
         );
     }
 
+    /// Where a late measurement at `t_s` goes: the last step at or before it that kept a
+    /// phase, unless a heading bank ran since.
+    fn late_target(&self, t_s: f64) -> LateTarget {
+        for (k, step) in self.history.iter().enumerate().rev() {
+            match step.kept {
+                Kept::Bank => return LateTarget::AsItIs,
+                Kept::Phase(_) if step.t_s <= t_s => return LateTarget::Step(k),
+                Kept::Phase(_) | Kept::Nothing => {}
+            }
+        }
+        LateTarget::TooOld
+    }
+
     /// Re-integrates the buffered IMU samples after `from_t_s` (the restored phase's
-    /// time), applying the pending measurements on the way.
+    /// time), applying the pending measurements on the way. A reset on the way (which
+    /// empties the buffers) ends the re-integration: the samples after it are taken as
+    /// new ones, as they were when they arrived after it.
     fn replay_after(&mut self, from_t_s: f64, out: &mut Vec<Output>) {
         let samples: Vec<ImuSample> = self
             .imu
@@ -607,10 +651,18 @@ impl Engine {
             .copied()
             .collect();
         self.replaying = true;
-        for s in &samples {
+        let mut done = samples.len();
+        for (k, s) in samples.iter().enumerate() {
             self.advance(s, out);
+            if self.imu.is_empty() {
+                done = k + 1;
+                break;
+            }
         }
         self.replaying = false;
+        for s in &samples[done..] {
+            self.take_body_sample(*s, out);
+        }
     }
 
     /// Processes everything up to the body-frame sample `s` (already buffered).
@@ -622,8 +674,11 @@ impl Engine {
             .is_some_and(|p| p.measurement.t_s() < s.t_s)
         {
             let p = self.pending.remove(0);
-            self.apply_measurement(&p, s, out);
-            applied.push(p.measurement);
+            let reported = self.apply_measurement(&p, s, out);
+            applied.push(Pending {
+                measurement: p.measurement,
+                reported,
+            });
         }
         match &mut self.phase {
             Phase::Initializing(init) => init.push_imu(s, &self.config),
@@ -673,22 +728,27 @@ impl Engine {
                 }
             }
         }
-        let keep = !matches!(self.phase, Phase::Aligning(_))
-            && (self.history.iter().rev())
-                .take(STATE_EVERY_STEPS - 1)
-                .all(|s| s.kept.is_none());
+        let due = (self.history.iter().rev())
+            .take(STATE_EVERY_STEPS - 1)
+            .all(|s| matches!(s.kept, Kept::Nothing));
+        let kept = match &self.phase {
+            Phase::Aligning(_) => Kept::Bank,
+            phase if due => Kept::Phase(phase.clone()),
+            _ => Kept::Nothing,
+        };
         self.history.push_back(Step {
             t_s: s.t_s,
-            kept: keep.then(|| self.phase.clone()),
+            kept,
             applied,
         });
     }
 
     /// Propagates to the measurement's time (running) or tries to start (initializing),
-    /// then applies it.
-    fn apply_measurement(&mut self, p: &Pending, next: &ImuSample, out: &mut Vec<Output>) {
+    /// then applies it; returns whether it is reported now (the running filter took it).
+    fn apply_measurement(&mut self, p: &Pending, next: &ImuSample, out: &mut Vec<Output>) -> bool {
         let t = p.measurement.t_s();
         let report = !p.reported;
+        let reported = p.reported || matches!(self.phase, Phase::Running(_));
         if let Measurement::Fix(f) = &p.measurement {
             self.constraints.note_fix(f);
         }
@@ -702,7 +762,7 @@ impl Engine {
                     if let Err(e) = state.propagate(&at_t, &noise) {
                         log::warn!("IMU step to the measurement at t = {t:.6} s failed: {e}");
                         self.counters.reject(RejectionReason::ImuStepFailed, t);
-                        return;
+                        return p.reported;
                     }
                 }
                 let w = state.compensate(&state.last_imu).w_ib_b_rad_s;
@@ -772,6 +832,7 @@ impl Engine {
                 }
             }
         }
+        reported
     }
 }
 

@@ -10,9 +10,10 @@ use super::RosAdapter;
 impl RosAdapter {
     /// The /diagnostics report at `stamp`: input counts, constraint updates by kind, fix
     /// positions and velocities deweighted as outliers, rejections by reason, resets after
-    /// a divergence, measurements applied late (by a roll-back), with `gnss.tdcp` the phase changes used and left out by reason, phase
-    /// and, in `tf_mode` `map_to_odom` the `odom → base` transforms heard and the Odometry
-    /// messages without a `map → odom`, once running, the filter's 3D position sigma
+    /// a divergence, measurements applied late (`late_measurements`), with `gnss.tdcp` the
+    /// phase changes used and left out by reason, phase and, in `tf_mode` `map_to_odom`
+    /// the `odom → base` transforms heard and the Odometry messages without a
+    /// `map → odom`, once running, the filter's 3D position sigma
     /// (level ERROR when it is not finite) and the scale factors it estimates; level ERROR
     /// from a divergence until the filter runs again, WARN while initializing or while a
     /// second frame sends on `imu`.

@@ -9,7 +9,7 @@
 //! moving-base pair, as ublox_dgnss names it), `/clock`
 //! (rosgraph_msgs/Clock, for `use_sim_time`); publishes `odometry` (nav_msgs/Odometry,
 //! `map_frame` → `base_frame`), `fix/filtered` (NavSatFix), `~/noise_estimates`
-//! (NoiseEstimates), `/diagnostics` (DiagnosticArray, 1 Hz), `/rosout`
+//! (NoiseEstimates), `/diagnostics` (DiagnosticArray, 1 Hz and at shutdown), `/rosout`
 //! (rcl_interfaces/Log), `/parameter_events` (rcl_interfaces/ParameterEvent: each
 //! parameter declared at the start, then each accepted set, as rclcpp announces them)
 //! and, with `publish_tf`, `/tf`
@@ -304,7 +304,9 @@ pub fn run(
                     let _ = rosout.send(message, &mut outputs.recorder, stamp);
                     Vec::new()
                 }
-                Event::Tick => {
+                // Choice: a last report on the way out, so that the counts of the whole
+                // run are on /diagnostics (and in a recording), not those of the last tick.
+                event @ (Event::Tick | Event::Shutdown) => {
                     let stamp = clock.now(parameters.use_sim_time());
                     let mut report = core.diagnostics(&fqn, stamp);
                     if let Some(status) = report.status.first_mut() {
@@ -313,11 +315,11 @@ pub fn run(
                     if let Err(e) = diagnostics.send(report, &mut outputs.recorder, stamp) {
                         log::warn!("publishing diagnostics failed: {e}");
                     }
+                    if matches!(event, Event::Shutdown) {
+                        log::info!("{fqn}: stopping on a signal");
+                        break;
+                    }
                     Vec::new()
-                }
-                Event::Shutdown => {
-                    log::info!("{fqn}: stopping on a signal");
-                    break;
                 }
             };
             outputs.publish(msgs, clock.now(parameters.use_sim_time()));
