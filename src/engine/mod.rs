@@ -99,9 +99,10 @@ pub use update::GnssFix;
 /// Choice: 10,000: 10 s of a 1 kHz IMU, the default 2 s of a 5 kHz one. Samples stamped
 /// microseconds apart (a flood, a broken clock) would otherwise fill the time window with
 /// millions of states; with the bound the buffers hold at most some 6 MB (a stored state
-/// is about 6 KB, most of it the covariance, one every [`STATE_EVERY_STEPS`]). Where it
-/// binds, a late measurement reaches back less far than `engine.imu_buffer_s` (rejected
-/// as too old, counted).
+/// is about 6 KB, most of it the covariance, one every [`STATE_EVERY_STEPS`]; during the
+/// start-up a kept initializer holds up to 5 s of fixes, some 12 KB at 10 Hz, so 12 MB).
+/// Where it binds, a late measurement reaches back less far than `engine.imu_buffer_s`
+/// (rejected as too old, counted).
 pub const MAX_BUFFERED_IMU_SAMPLES: usize = 10_000;
 
 /// The phase (the filter state, or the initializer) is kept for roll-backs after every
