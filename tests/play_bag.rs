@@ -19,6 +19,7 @@ use std::time::{Duration, Instant};
 use adaptive_gnss_ins::config::Config;
 use adaptive_gnss_ins::ros::bag::BagReader;
 use adaptive_gnss_ins::ros::cdr;
+use adaptive_gnss_ins::ros::convert::time_to_seconds;
 use adaptive_gnss_ins::ros::msg::{
     Clock, DiagnosticArray, GnssMeasurements, Imu, NavSatFix, Odometry, RosMessage, TFMessage,
     Time, TransformStamped,
@@ -155,7 +156,7 @@ fn play_publishes_the_bag_unchanged() {
     assert_same_messages("Imu", &encoded(&imu), &want_imu);
     assert_same_messages("GnssMeasurements", &encoded(&gnss), &want_gnss);
 
-    let seconds = |c: &Clock| f64::from(c.clock.sec) + f64::from(c.clock.nanosec) * 1e-9;
+    let seconds = |c: &Clock| time_to_seconds(&c.clock).unwrap();
     let first_imu = &imu[0].header.stamp;
     let last_imu = &imu[imu.len() - 1].header.stamp;
     let bag_start = f64::from(first_imu.sec) + f64::from(first_imu.nanosec) * 1e-9;
@@ -314,7 +315,7 @@ fn node_records_the_replay_solution(
 
 /// The stamps (s) of the GNSS inputs of `bag` (`/gnss/measurements`, `/gnss/fix`), sorted.
 fn measurement_stamps_s(bag: &Path) -> Vec<f64> {
-    let seconds = |t: &Time| f64::from(t.sec) + f64::from(t.nanosec) * 1e-9;
+    let seconds = |t: &Time| time_to_seconds(t).unwrap();
     let mut stamps: Vec<f64> = decoded::<GnssMeasurements>(bag, "/gnss/measurements")
         .iter()
         .map(|m| seconds(&m.header.stamp))

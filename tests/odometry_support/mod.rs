@@ -6,6 +6,7 @@ use std::path::Path;
 
 use adaptive_gnss_ins::ros::bag::BagReader;
 use adaptive_gnss_ins::ros::cdr;
+use adaptive_gnss_ins::ros::convert::time_to_seconds;
 use adaptive_gnss_ins::ros::msg::{Odometry, RosMessage};
 
 /// The messages of `topic` in `bag`, in log-time order.
@@ -84,8 +85,7 @@ pub fn assert_live_matches_replay(
     what: &str,
 ) -> LiveAgainstReplay {
     assert_eq!(live.len(), offline.len(), "Odometry messages: {what}");
-    let seconds =
-        |o: &Odometry| f64::from(o.header.stamp.sec) + f64::from(o.header.stamp.nanosec) * 1e-9;
+    let seconds = |o: &Odometry| time_to_seconds(&o.header.stamp).unwrap();
     let mut result = LiveAgainstReplay {
         solutions: live.len(),
         late_runs: 0,
