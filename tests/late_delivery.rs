@@ -1,10 +1,10 @@
 //! GNSS inputs delivered late, as DDS may (it gives no order across topics): each
 //! measurement that arrives after the IMU passed its stamp rolls the engine back (during
-//! the start-up too), so the adapter publishes the solutions of an in-time delivery but for
-//! those it published before the measurement arrived, and publishes them all (a start
-//! found late included), with every epoch's report once. Driven through the adapter, as the node and `gnss_ins replay`
-//! drive it, on the fixture's scenario: tightly coupled, and loosely coupled with receiver
-//! velocities (a fix waits for its velocity).
+//! the start-up too), so the adapter publishes the solutions of an in-time delivery but
+//! for those it published before the measurement arrived, and publishes them all (a start
+//! found late included), with every epoch's report once. Driven through the adapter, as
+//! the node and `gnss_ins replay` drive it, on the fixture's scenario: tightly coupled,
+//! and loosely coupled with receiver velocities (a fix waits for its velocity).
 
 mod odometry_support;
 
