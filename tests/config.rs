@@ -128,6 +128,7 @@ const EVERY_KEY_CHANGED: &str = "
       fix_sigma_vertical_m: 4.5
       velocity_sigma_mps: 0.3
       fix_outlier_sigma: 8.0
+      fix_consistency: false
     adaptive:
       window_size_m: 60
       min_samples: 20

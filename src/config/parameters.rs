@@ -386,6 +386,14 @@ parameter_table! {
         // most of the way.
         fix_outlier_sigma: f64 = 5.0,
             unit "sigma", range Range::OffOrWithin(Interval::closed(1.0, 1e6)), at_run_time;
+        /// Judge each fix's claimed position (and velocity) covariance by the filter's
+        /// innovations: once 4 of the last 10 fixes lie beyond the 95 % quantile of their
+        /// χ²(3) (until at most 1 does), the next fix's covariance is scaled by the median
+        /// of the factors that make each fix's innovation typical, at most 25 (receivers
+        /// claim far too little in foliage); counted (fix_position_rescaled,
+        /// fix_velocity_rescaled). false = take the claim as it is (the IARF paper's
+        /// filters).
+        fix_consistency: bool = true, unit "", range ANY, at_start;
     }
 
     /// Online measurement-noise estimation of the ERMAKF family, used by the variants

@@ -10,6 +10,7 @@ use crate::config::{AdaptiveFactorKind, Config, EquivalentWeightKind, RobustSche
 use crate::filter::robust_update::{RobustUpdate, Scheme};
 
 use super::adaptive_noise::NoiseModel;
+use super::fix_consistency::FixConsistency;
 use super::q_scaling::QScaling;
 
 /// The adaptive parts of the configured variant.
@@ -23,6 +24,9 @@ pub struct Adaptation {
     pub update: RobustUpdate,
     /// Scale of the process noise Q.
     pub q: QScaling,
+    /// The judges of the receiver fixes' claimed covariance (loose coupling): of the
+    /// position, and of the velocity.
+    pub fix: [FixConsistency; 2],
 }
 
 impl Adaptation {
@@ -33,6 +37,7 @@ impl Adaptation {
             noise: NoiseModel::new(config),
             update: robust_update(config),
             q: QScaling::new(config),
+            fix: [(); 2].map(|()| FixConsistency::new(config.loose.fix_consistency)),
         }
     }
 
@@ -40,6 +45,7 @@ impl Adaptation {
     pub fn reset(&mut self) {
         self.noise.reset();
         self.q.reset();
+        self.fix.iter_mut().for_each(FixConsistency::reset);
     }
 }
 

@@ -50,6 +50,7 @@ mod constraints;
 pub mod divergence;
 mod dual_antenna;
 mod filter_state;
+pub(crate) mod fix_consistency;
 mod fix_track;
 pub mod gyrocompass;
 pub mod heading_bank;

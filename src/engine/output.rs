@@ -239,6 +239,10 @@ pub struct EpochReport {
     /// `loose.fix_outlier_sigma` and was deweighted.
     pub fix_position_outlier: bool,
     pub fix_velocity_outlier: bool,
+    /// The factors on a loosely-coupled fix's claimed position covariance, then on its
+    /// velocity's, from the fixes before (`loose.fix_consistency`; 1: taken as claimed);
+    /// empty in tight coupling.
+    pub fix_scales: Vec<f64>,
     /// The report of the epoch's time-differenced carrier-phase update, applied before the
     /// pseudo-ranges (`gnss.tdcp`; None when off or without a previous epoch's phases).
     pub carrier_phase_deltas: Option<Box<EpochReport>>,
@@ -264,17 +268,21 @@ impl EpochReport {
             fix_robust_weights: Vec::new(),
             fix_position_outlier: false,
             fix_velocity_outlier: false,
+            fix_scales: Vec::new(),
             carrier_phase_deltas: None,
         }
     }
 }
 
 /// The receiver fixes whose position or velocity was deweighted as an outlier
-/// (`loose.fix_outlier_sigma`), so far (shown on /diagnostics).
+/// (`loose.fix_outlier_sigma`), and those whose claimed position or velocity covariance
+/// was scaled (`loose.fix_consistency`), so far (shown on /diagnostics).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct FixOutliers {
     pub position: u64,
     pub velocity: u64,
+    pub position_rescaled: u64,
+    pub velocity_rescaled: u64,
 }
 
 impl FixOutliers {
@@ -282,6 +290,10 @@ impl FixOutliers {
     pub fn count(&mut self, report: &EpochReport) {
         self.position += u64::from(report.fix_position_outlier);
         self.velocity += u64::from(report.fix_velocity_outlier);
+        let rescaled =
+            |block: usize| u64::from(report.fix_scales.get(block).is_some_and(|&s| s > 1.0));
+        self.position_rescaled += rescaled(0);
+        self.velocity_rescaled += rescaled(1);
     }
 }
 

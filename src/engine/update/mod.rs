@@ -64,7 +64,8 @@ use crate::ins::error_state::{StateVector, N};
 use super::adaptation::Adaptation;
 use super::adaptive_noise::ScalarMeasurement;
 use super::filter_state::FilterState;
-use super::output::EpochReport;
+use super::fix_consistency;
+use super::output::{EpochReport, MeasurementKind};
 use super::phase_anchor::PhaseAnchor;
 use gate::{gate, GateRow};
 
@@ -243,6 +244,9 @@ impl<M: MeasurementModel> Step<'_, M> {
         let mut r = self.adaptation.noise.joint_covariance(kind, r_nominal);
         self.report.q_scale = self.adaptation.q.scale();
         let y = innovations(lin);
+        if let (MeasurementKind::Fix, Some((block_lengths, _))) = (kind, outliers) {
+            self.judge_fix_blocks(state, lin, &y, &mut r, block_lengths);
+        }
         let every: Vec<usize> = (0..lin.rows.len()).collect();
         let (kept, outlying) = match outliers {
             Some((block_lengths, outlier_sigma)) if outlier_sigma > 0.0 => {
@@ -271,6 +275,47 @@ impl<M: MeasurementModel> Step<'_, M> {
             );
         }
         Ok(())
+    }
+
+    /// Scales the claimed covariance of each block of a fix (its position, then its
+    /// velocity: consecutive rows of `r` from row 0) by its judge's verdict on the fixes
+    /// before ([`super::fix_consistency`]), then gives each judge this fix's block judged
+    /// under the claim.
+    fn judge_fix_blocks(
+        &mut self,
+        state: &FilterState,
+        lin: &Linearization,
+        y: &[f64],
+        r: &mut DMatrix<f64>,
+        block_lengths: &[usize],
+    ) {
+        let p = DMatrix::from_column_slice(N, N, state.p.as_slice());
+        let mut start = 0;
+        for (block, &len) in block_lengths.iter().enumerate() {
+            let indices: Vec<usize> = (start..start + len).collect();
+            start += len;
+            let Some(judge) = self.adaptation.fix.get_mut(block) else {
+                continue;
+            };
+            let rows = Rows::select(lin, y, &indices);
+            let hph = &rows.h * &p * rows.h.transpose();
+            let claimed = r.select_rows(&indices).select_columns(&indices);
+            let judged = fix_consistency::Judged::of(&rows.y, &hph, &claimed);
+            let scale = judge.scale();
+            if scale > 1.0 {
+                let factor = scale.sqrt();
+                for &i in &indices {
+                    r.row_mut(i).scale_mut(factor);
+                    r.column_mut(i).scale_mut(factor);
+                }
+            }
+            if self.learn {
+                if let Some(judged) = judged {
+                    judge.push(judged);
+                }
+            }
+            self.report.fix_scales.push(scale);
+        }
     }
 
     /// Bounds the pull of each block of `block_lengths` (consecutive rows from row 0)
@@ -302,16 +347,13 @@ impl<M: MeasurementModel> Step<'_, M> {
         for (block, &len) in block_lengths.iter().enumerate() {
             let indices: Vec<usize> = (start..start + len).collect();
             start += len;
-            let rows = Rows::select(lin, y, &indices);
-            let s = &rows.h * &p * rows.h.transpose()
-                + r.select_rows(&indices).select_columns(&indices);
-            let Some(chol) = s.cholesky() else {
+            let Some(nis) = block_nis(&p, lin, y, r, &indices) else {
                 outlying = true;
                 self.model
                     .report_outlying_block(&mut self.report, block, f64::NAN);
                 continue;
             };
-            let sigmas = rows.y.dot(&chol.solve(&rows.y)).sqrt();
+            let sigmas = nis.sqrt();
             if sigmas > outlier_sigma {
                 outlying = true;
                 let factor = sigmas / outlier_sigma;
@@ -377,6 +419,21 @@ fn innovations(lin: &Linearization) -> Vec<f64> {
         .zip(&lin.measured)
         .map(|(predicted, measured)| predicted - measured)
         .collect()
+}
+
+/// The normalised innovation squared yᵀ S⁻¹ y of the rows `indices` under
+/// S = H P Hᵀ + R (their block of `r`); None when S is not positive definite.
+fn block_nis(
+    p: &DMatrix<f64>,
+    lin: &Linearization,
+    y: &[f64],
+    r: &DMatrix<f64>,
+    indices: &[usize],
+) -> Option<f64> {
+    let rows = Rows::select(lin, y, indices);
+    let s = &rows.h * p * rows.h.transpose() + r.select_rows(indices).select_columns(indices);
+    let chol = s.cholesky()?;
+    Some(rows.y.dot(&chol.solve(&rows.y)))
 }
 
 /// The rows of the linearization that go into the update.

@@ -42,6 +42,8 @@ impl RosAdapter {
             ("updates_non_holonomic", updates.non_holonomic),
             ("fix_position_outliers", outliers.position),
             ("fix_velocity_outliers", outliers.velocity),
+            ("fix_position_rescaled", outliers.position_rescaled),
+            ("fix_velocity_rescaled", outliers.velocity_rescaled),
         ] {
             values.push(key_value(key, n.to_string()));
         }

@@ -1,0 +1,103 @@
+//! `loose.fix_consistency` on the engine tests' simulated drive: a receiver whose fixes err
+//! by 2 m per axis (white) and that claims 0.5 m from 60 s on (a quarter: the judge scales
+//! a claim by up to σ × 5), loosely coupled with the
+//! default IMU. With the claim taken as given the filter's covariance is exceeded on most
+//! epochs; judged by the filter's innovations, the claim is scaled (counted) and the
+//! filter's 9-state NEES is inside its 95 % bound on most epochs. A receiver that claims
+//! what it errs is left alone.
+
+use adaptive_gnss_ins::config::{Config, Coupling};
+use adaptive_gnss_ins::engine::Engine;
+use adaptive_gnss_ins::eval;
+use adaptive_gnss_ins::sim::{ImuErrorModel, ImuErrorSpec, Trajectory};
+use nalgebra::Matrix3;
+use statrs::distribution::{ChiSquared, ContinuousCDF};
+
+mod support;
+use support::drive::drive;
+use support::fixes::{FixNoise, Fixes};
+
+/// The fixes' error per axis (m, white).
+const ERROR_M: f64 = 2.0;
+/// The receiver claims its error until this time (s), so the filter starts on an honest
+/// claim (a start-up on the misclaim takes its heading from it: 76° off), then its claim.
+const MISCLAIM_FROM_S: f64 = 60.0;
+/// Scored from this time (s): 60 s after the misclaim began, the settling the start and
+/// divergence tests give (the judge needs 10 fixes to declare, and the filter, made
+/// over-confident by the misclaim until then, some 40 s more to become honest: from 90 s
+/// on 89 % of the epochs are inside, from 120 s on 97 %).
+const SCORED_FROM_S: f64 = 120.0;
+
+/// What one run saw from [`SCORED_FROM_S`] on: the share of epochs whose NEES lies within the 95 %
+/// bound of χ²(9), and the fixes whose claim was scaled.
+struct Run {
+    inside_share: f64,
+    rescaled: u64,
+}
+
+fn run(claimed_m: f64, judged: bool) -> Run {
+    let trajectory = Trajectory::new(&drive(1)).unwrap();
+    let mut imu = ImuErrorModel::new(&ImuErrorSpec::default(), 100.0, 42).unwrap();
+    let noise = FixNoise {
+        gm_sigma_m: [0.0, 0.0],
+        white_sigma_m: [ERROR_M, ERROR_M],
+    };
+    let mut fixes = Fixes::new(noise, 3);
+    let mut config = Config::default();
+    config.filter.coupling = Coupling::Loose;
+    config.loose.fix_consistency = judged;
+    let mut engine = Engine::new(config);
+    let bound = ChiSquared::new(9.0).unwrap().inverse_cdf(0.95);
+    let (mut scored, mut inside) = (0, 0);
+    for truth in trajectory.samples(100.0).unwrap() {
+        let t = truth.nav.t_s;
+        engine.push_imu(&imu.corrupt(&truth.imu)).unwrap();
+        if (t - t.round()).abs() > 1e-9 {
+            continue;
+        }
+        let mut fix = fixes.fix(&truth.nav);
+        let claim_m = if t < MISCLAIM_FROM_S {
+            ERROR_M
+        } else {
+            claimed_m
+        };
+        fix.position_covariance_enu_m2 = Some(Matrix3::identity() * claim_m.powi(2));
+        engine.push_fix(fix).unwrap();
+        let Some(state) = engine.state() else {
+            continue;
+        };
+        if t < SCORED_FROM_S {
+            continue;
+        }
+        let reference = eval::TruthSample::from(&truth.nav);
+        let nees = eval::solution_error(&state.solution(), &reference).nees;
+        scored += 1;
+        inside += usize::from(nees <= bound);
+    }
+    assert!(scored > 100, "{scored} epochs scored");
+    Run {
+        inside_share: inside as f64 / scored as f64,
+        rescaled: engine.fix_outliers().position_rescaled,
+    }
+}
+
+#[test]
+fn a_receiver_claiming_a_quarter_of_its_error_is_judged_and_the_filter_is_honest() {
+    let taken = run(ERROR_M / 4.0, false);
+    let judged = run(ERROR_M / 4.0, true);
+    let truthful = run(ERROR_M, true);
+    println!(
+        "inside the 95 % NEES bound: claim taken {:.3}, judged {:.3} ({} fixes rescaled), \
+         a truthful receiver {:.3} ({} rescaled)",
+        taken.inside_share,
+        judged.inside_share,
+        judged.rescaled,
+        truthful.inside_share,
+        truthful.rescaled
+    );
+    assert!(taken.inside_share < 0.5, "the test sees the misclaim");
+    assert_eq!(taken.rescaled, 0);
+    assert!(judged.inside_share >= 0.9, "{}", judged.inside_share);
+    assert!(judged.rescaled > 100, "{}", judged.rescaled);
+    assert!(truthful.inside_share >= 0.9, "{}", truthful.inside_share);
+}
