@@ -290,10 +290,7 @@ impl<M: MeasurementModel> Step<'_, M> {
         block_lengths: &[usize],
     ) {
         let p = DMatrix::from_column_slice(N, N, state.p.as_slice());
-        let mut start = 0;
-        for (block, &len) in block_lengths.iter().enumerate() {
-            let indices: Vec<usize> = (start..start + len).collect();
-            start += len;
+        for (block, indices) in blocks(block_lengths).enumerate() {
             let Some(judge) = self.adaptation.fix.get_mut(block) else {
                 continue;
             };
@@ -302,13 +299,7 @@ impl<M: MeasurementModel> Step<'_, M> {
             let claimed = r.select_rows(&indices).select_columns(&indices);
             let judged = fix_consistency::Judged::of(&rows.y, &hph, &claimed);
             let scale = judge.scale();
-            if scale > 1.0 {
-                let factor = scale.sqrt();
-                for &i in &indices {
-                    r.row_mut(i).scale_mut(factor);
-                    r.column_mut(i).scale_mut(factor);
-                }
-            }
+            scale_block(r, &indices, scale);
             if self.learn {
                 if let Some(judged) = judged {
                     judge.push(judged);
@@ -343,10 +334,7 @@ impl<M: MeasurementModel> Step<'_, M> {
         let p = DMatrix::from_column_slice(N, N, state.p.as_slice());
         let mut kept = Vec::with_capacity(lin.rows.len());
         let mut outlying = false;
-        let mut start = 0;
-        for (block, &len) in block_lengths.iter().enumerate() {
-            let indices: Vec<usize> = (start..start + len).collect();
-            start += len;
+        for (block, indices) in blocks(block_lengths).enumerate() {
             let Some(nis) = block_nis(&p, lin, y, r, &indices) else {
                 outlying = true;
                 self.model
@@ -356,11 +344,7 @@ impl<M: MeasurementModel> Step<'_, M> {
             let sigmas = nis.sqrt();
             if sigmas > outlier_sigma {
                 outlying = true;
-                let factor = sigmas / outlier_sigma;
-                for &i in &indices {
-                    r.row_mut(i).scale_mut(factor);
-                    r.column_mut(i).scale_mut(factor);
-                }
+                scale_block(r, &indices, (sigmas / outlier_sigma).powi(2));
                 self.model
                     .report_outlying_block(&mut self.report, block, sigmas);
             }
@@ -419,6 +403,28 @@ fn innovations(lin: &Linearization) -> Vec<f64> {
         .zip(&lin.measured)
         .map(|(predicted, measured)| predicted - measured)
         .collect()
+}
+
+/// The rows of each block of `block_lengths` (consecutive, from row 0).
+fn blocks(block_lengths: &[usize]) -> impl Iterator<Item = Vec<usize>> + '_ {
+    block_lengths.iter().scan(0, |start, &len| {
+        let indices = (*start..*start + len).collect();
+        *start += len;
+        Some(indices)
+    })
+}
+
+/// Scales the covariance of the rows `indices` of `r` by `scale` (their rows and columns
+/// by its root); nothing at 1 or below.
+fn scale_block(r: &mut DMatrix<f64>, indices: &[usize], scale: f64) {
+    if scale <= 1.0 {
+        return;
+    }
+    let factor = scale.sqrt();
+    for &i in indices {
+        r.row_mut(i).scale_mut(factor);
+        r.column_mut(i).scale_mut(factor);
+    }
 }
 
 /// The normalised innovation squared yᵀ S⁻¹ y of the rows `indices` under
