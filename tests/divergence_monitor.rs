@@ -21,6 +21,7 @@ use adaptive_gnss_ins::config::{Config, Coupling, FilterVariant};
 use adaptive_gnss_ins::engine::{Engine, FilterState, GnssFix, Output, ResetReason, StatusEvent};
 use adaptive_gnss_ins::eval;
 use adaptive_gnss_ins::gnss::GnssEpoch;
+use adaptive_gnss_ins::ins::error_state::PHI;
 use adaptive_gnss_ins::ins::ImuSample;
 use adaptive_gnss_ins::sim::constellation::GpsConstellation;
 use adaptive_gnss_ins::sim::{ImuErrorModel, ImuErrorSpec, Trajectory};
@@ -70,6 +71,10 @@ struct Run {
     /// Scored epochs after the restart and the largest NEES among them.
     scored: usize,
     worst_nees: f64,
+    /// Most heading hypotheses a split of the running filter had at once, and the largest
+    /// yaw error at a GNSS epoch while split, in units of the published yaw σ.
+    most_heading_hypotheses: usize,
+    worst_split_yaw_sigmas: f64,
     /// Every GNSS epoch while running: time (s), 3D position error and the filter's 3D
     /// position σ (m).
     epochs: Vec<(f64, f64, f64)>,
@@ -113,6 +118,7 @@ fn run_late(
         &ImuErrorSpec::default(),
         Config::default(),
         gnss_delay_samples,
+        true,
     )
 }
 
@@ -123,6 +129,7 @@ fn run_with(
     imu_spec: &ImuErrorSpec,
     mut config: Config,
     gnss_delay_samples: usize,
+    nees_asserted: bool,
 ) -> Run {
     let name = format!("{variant:?} {coupling:?} fault {fault:?}");
     let trajectory = Trajectory::new(&drive(1)).unwrap();
@@ -142,6 +149,8 @@ fn run_with(
         worst_error_before_reset_m: 0.0,
         scored: 0,
         worst_nees: 0.0,
+        most_heading_hypotheses: 0,
+        worst_split_yaw_sigmas: 0.0,
         epochs: Vec::new(),
     };
     // The GNSS input waiting for its delivery: the sample it is due after, and the input.
@@ -192,6 +201,8 @@ fn run_with(
                 _ => {}
             }
         }
+        let hypotheses = engine.heading_hypotheses();
+        result.most_heading_hypotheses = result.most_heading_hypotheses.max(hypotheses);
         let Some(state) = engine.state() else {
             continue;
         };
@@ -205,6 +216,11 @@ fn run_with(
             let e = error.position_enu_m.norm();
             result.epochs.push((t, e, position_sigma_3d_m(state)));
         }
+        if epoch_due && hypotheses > 0 {
+            let yaw_error_rad = error.attitude_rpy_rad.unwrap()[2];
+            let sigmas = yaw_error_rad.abs() / state.p[(PHI + 2, PHI + 2)].sqrt();
+            result.worst_split_yaw_sigmas = result.worst_split_yaw_sigmas.max(sigmas);
+        }
         let restarted = result.starts.len() > 1;
         let since_start = t - result.starts.last().copied().unwrap_or(f64::INFINITY);
         if epoch_due && restarted && since_start >= SETTLING_S {
@@ -212,7 +228,7 @@ fn run_with(
             result.scored += 1;
             result.worst_nees = result.worst_nees.max(error.nees);
             assert!(
-                error.nees <= chi2,
+                !nees_asserted || error.nees <= chi2,
                 "{name}: NEES {:.1} beyond 3σ ({chi2:.1}) at {t} s: {error:?}",
                 error.nees
             );
@@ -225,12 +241,15 @@ fn run_with(
     );
     println!(
         "{name}: resets at {:?} s, starts at {:?} s, worst error before the reset {:.1} m, \
-         {} epochs scored after the restart, worst NEES {:.1} (3σ: {chi2:.1})",
+         {} epochs scored after the restart, worst NEES {:.1} (3σ: {chi2:.1}), at most {} \
+         heading hypotheses (yaw error while split at most {:.1} σ)",
         result.resets,
         result.starts,
         result.worst_error_before_reset_m,
         result.scored,
-        result.worst_nees
+        result.worst_nees,
+        result.most_heading_hypotheses,
+        result.worst_split_yaw_sigmas
     );
     result
 }
@@ -345,6 +364,7 @@ fn gyro_fault_is_detected_reset_and_recovered(coupling: Coupling, config: Config
             &consumer_mems_imu(),
             config.clone(),
             0,
+            true,
         );
         let [reset_t_s] = r.resets.as_slice() else {
             panic!("{variant:?}: one reset expected: {r:?}");
@@ -393,5 +413,35 @@ fn a_filter_that_jumps_within_a_second_is_detected_reset_and_recovered() {
             "{variant:?}: reset at {reset_t_s} s: {r:?}"
         );
         assert!(r.scored > 60, "{variant:?}: {r:?}");
+    }
+}
+
+/// The same fault loosely coupled without a motion constraint. The restarted filter's wide
+/// vertical gyro bias prior lets its heading σ grow beyond 15° on the straight climb, and
+/// the running filter splits into a bank of heading hypotheses (src/engine/heading_bank.rs)
+/// that keeps publishing: one reset only, and while split the published yaw within 3σ of
+/// the truth. Not yet honest: once the split has collapsed, the single filter's roll and
+/// yaw through the next turn (worst NEES about 90 against the 3σ bound of 25.3, yaw 3.2σ
+/// off; before the split NEES 276 and two more resets; docs/results.md), so the NEES is
+/// printed, not asserted.
+#[test]
+fn a_gyro_bias_jump_loosely_coupled_without_a_constraint_splits_the_heading() {
+    for variant in [FilterVariant::Ekf, FilterVariant::Iarf] {
+        let r = run_with(
+            variant,
+            Coupling::Loose,
+            Fault::GyroBiasTenfold,
+            &consumer_mems_imu(),
+            consumer_mems_config(),
+            0,
+            false,
+        );
+        assert_eq!(r.resets.len(), 1, "{variant:?}: {r:?}");
+        assert!(
+            r.most_heading_hypotheses > 1,
+            "{variant:?}: no split: {r:?}"
+        );
+        assert!(r.scored > 60, "{variant:?}: {r:?}");
+        assert!(r.worst_split_yaw_sigmas <= 3.0, "{variant:?}: {r:?}");
     }
 }

@@ -192,3 +192,36 @@ pub fn interpolate(a: &ImuSample, b: &ImuSample, t_s: f64) -> ImuSample {
         f_ib_b_m_s2: a.f_ib_b_m_s2.lerp(&b.f_ib_b_m_s2, w),
     }
 }
+
+#[cfg(test)]
+impl FilterState {
+    /// A level state at 39.1° N moving slowly, with the covariance `p_diagonal` × I (for
+    /// tests).
+    pub(crate) fn moving(p_diagonal: f64) -> Self {
+        let imu = ImuSample {
+            t_s: 0.0,
+            w_ib_b_rad_s: Vector3::zeros(),
+            f_ib_b_m_s2: Vector3::new(0.0, 0.0, 9.8),
+        };
+        Self {
+            nav: NavState {
+                t_s: 0.0,
+                p: crate::earth::Llh::from_degrees(39.1, 117.2, 20.0),
+                v_n: Vector3::new(0.5, -0.2, 0.1),
+                q_nb: UnitQuaternion::identity(),
+            },
+            gyro_bias_rad_s: Vector3::zeros(),
+            gyro_markov_rad_s: Vector3::zeros(),
+            accel_bias_m_s2: Vector3::zeros(),
+            clock_bias_m: 0.0,
+            clock_drift_mps: 0.0,
+            wheel_scale_factor: 1.0,
+            gyro_scale_error: Vector3::zeros(),
+            accel_scale_error: Vector3::zeros(),
+            p: StateMatrix::identity() * p_diagonal,
+            prev_increment: None,
+            last_imu: imu,
+            phase_anchor: None,
+        }
+    }
+}

@@ -36,7 +36,11 @@
 //! - Start-up (`initializer`): levelled at rest, or aligned in motion from GNSS when
 //!   the IMU's window is not at rest (a start or a restart mid-drive); a start whose
 //!   heading is too uncertain for one filter runs a bank of heading hypotheses first
-//!   ([`heading_bank`]), and nothing is published until it has decided.
+//!   ([`heading_bank`]), and nothing is published until it has decided. A running filter
+//!   whose heading σ leaves the linear range while moving splits into such a bank, which
+//!   publishes its moment-matched state (`heading_hypotheses`); the bank's steps are
+//!   kept for no roll-back, and neither the motion constraints nor the divergence monitor
+//!   run in it (each hypothesis is a plain EKF scored on the GNSS alone).
 //! - IMU samples are screened first ([`imu_screen`]): one beyond the sensor's range or a
 //!   lone spike is dropped and counted, and the strapdown step spans it.
 //! - Each GNSS input seen for the first time feeds the divergence monitor ([`divergence`],
@@ -317,11 +321,22 @@ impl Engine {
         self.diverged_at_t_s
     }
 
-    /// The running filter state, or None while initializing.
+    /// The running filter state (of a split heading, the one it publishes), or None while
+    /// initializing.
     pub fn state(&self) -> Option<&FilterState> {
         match &self.phase {
             Phase::Running(s) => Some(s),
-            Phase::Initializing(_) | Phase::Aligning(_) => None,
+            Phase::Aligning(bank) => bank.published(),
+            Phase::Initializing(_) => None,
+        }
+    }
+
+    /// The heading hypotheses of a split of the running filter (see [`heading_bank`]), 0
+    /// while one filter runs or before the start.
+    pub fn heading_hypotheses(&self) -> usize {
+        match &self.phase {
+            Phase::Aligning(bank) if bank.published().is_some() => bank.len(),
+            _ => 0,
         }
     }
 
@@ -329,8 +344,8 @@ impl Engine {
     pub fn init_phase(&self) -> Option<InitPhase> {
         match &self.phase {
             Phase::Initializing(init) => Some(init.phase()),
-            Phase::Aligning(_) => Some(InitPhase::AligningHeading),
-            Phase::Running(_) => None,
+            Phase::Aligning(bank) if bank.published().is_none() => Some(InitPhase::AligningHeading),
+            Phase::Aligning(_) | Phase::Running(_) => None,
         }
     }
 
@@ -367,16 +382,16 @@ impl Engine {
     /// learned so far is kept when the filter was running, unless it diverged (see
     /// [`Initializer::after_divergence`]).
     pub fn reset(&mut self, t_s: f64, reason: ResetReason) -> Output {
-        let init = match &self.phase {
-            Phase::Running(_) if reason == ResetReason::DivergedFromGnss => {
+        let init = match self.state() {
+            Some(_) if reason == ResetReason::DivergedFromGnss => {
                 Box::new(Initializer::after_divergence())
             }
-            Phase::Running(s) => Box::new(Initializer::with_attitude(
+            Some(s) => Box::new(Initializer::with_attitude(
                 s.nav.q_nb,
                 s.gyro_bias_rad_s + s.gyro_markov_rad_s,
                 s.last_imu.t_s,
             )),
-            Phase::Initializing(_) | Phase::Aligning(_) => Box::default(),
+            None => Box::default(),
         };
         self.phase = Phase::Initializing(init);
         self.adaptation.reset();
@@ -697,6 +712,12 @@ impl Engine {
                         return;
                     }
                 }
+                if let Some(published) = bank.published() {
+                    let t_s = published.last_imu.t_s;
+                    if output_due(self.config.output.rate_hz, &mut self.last_output_t_s, t_s) {
+                        out.push(Output::Solution(Box::new(published.solution())));
+                    }
+                }
             }
             Phase::Running(state) => {
                 if state.last_imu.t_s < s.t_s {
@@ -728,6 +749,13 @@ impl Engine {
                 if output_due(self.config.output.rate_hz, &mut self.last_output_t_s, t_s) {
                     out.push(Output::Solution(Box::new(state.solution())));
                 }
+                let moving = state.nav.v_n.xy().norm() >= self.config.init.heading_min_speed_mps;
+                if let Some(bank) = moving
+                    .then(|| HeadingBank::split(state, &self.config))
+                    .flatten()
+                {
+                    self.phase = Phase::Aligning(Box::new(bank));
+                }
             }
         }
         let due = (self.history.iter().rev())
@@ -750,13 +778,13 @@ impl Engine {
     fn apply_measurement(&mut self, p: &Pending, next: &ImuSample, out: &mut Vec<Output>) -> bool {
         let t = p.measurement.t_s();
         let report = !p.reported;
-        let reported = p.reported || matches!(self.phase, Phase::Running(_));
+        let reported = p.reported || self.state().is_some();
         if let Measurement::Fix(f) = &p.measurement {
             self.constraints.note_fix(f);
         }
         match &mut self.phase {
             Phase::Initializing(_) => self.try_start(&p.measurement, next, out),
-            Phase::Aligning(_) => self.update_bank(&p.measurement, next, out),
+            Phase::Aligning(_) => self.update_bank(&p.measurement, next, report, out),
             Phase::Running(state) => {
                 if state.last_imu.t_s < t {
                     let at_t = interpolate(&state.last_imu, next, t);

@@ -7,7 +7,7 @@ use super::filter_state::{interpolate, FilterState};
 use super::heading_bank::{self, HeadingBank};
 use super::initializer::InitialState;
 use super::update;
-use super::{Engine, Measurement, Output, Phase, StatusEvent};
+use super::{Engine, Measurement, Output, Phase, ResetReason, StatusEvent};
 use crate::ins::ImuSample;
 
 impl Engine {
@@ -96,14 +96,21 @@ impl Engine {
         }
     }
 
-    /// Updates every hypothesis of the heading bank with `m`; starts the filter once the
-    /// bank has decided.
-    pub(super) fn update_bank(&mut self, m: &Measurement, next: &ImuSample, out: &mut Vec<Output>) {
+    /// Updates every hypothesis of the heading bank with `m`; a split of the running filter
+    /// reports its best hypothesis' epoch (when `report`, as the running filter). Runs one
+    /// filter again once the bank has decided.
+    pub(super) fn update_bank(
+        &mut self,
+        m: &Measurement,
+        next: &ImuSample,
+        report: bool,
+        out: &mut Vec<Output>,
+    ) {
         let Phase::Aligning(bank) = &mut self.phase else {
             return;
         };
         let t = m.t_s();
-        bank.update(t, next, &self.process_noise, |state, adaptation, config| {
+        let epoch = bank.update(t, next, &self.process_noise, |state, adaptation, config| {
             let w = state.compensate(&state.last_imu).w_ib_b_rad_s;
             match m {
                 Measurement::Gnss(e) => {
@@ -125,8 +132,19 @@ impl Engine {
             }
         });
         if bank.is_empty() {
-            self.phase = Phase::Initializing(Box::default());
+            // A split was the running filter: its loss is a reset, said so.
+            if bank.published().is_some() {
+                let reset = self.reset(t, ResetReason::Diverged);
+                out.push(reset);
+            } else {
+                self.phase = Phase::Initializing(Box::default());
+            }
             return;
+        }
+        let gnss = matches!(m, Measurement::Gnss(_) | Measurement::Fix(_));
+        if let Some(epoch) = epoch.filter(|_| report && gnss && bank.published().is_some()) {
+            self.fix_outliers.count(&epoch);
+            out.push(Output::Epoch(epoch));
         }
         if let Some(state) = bank.resolved(t) {
             self.start_running(state, true, out);

@@ -5,10 +5,9 @@
 use nalgebra::{DVector, UnitQuaternion, Vector3};
 
 use crate::config::{Config, Coupling, FilterVariant};
-use crate::earth::{self, Llh};
+use crate::earth;
 use crate::filter::robust_update::UpdateOutcome;
-use crate::ins::error_state::{StateMatrix, StateVector, DP, DV, N, PHI};
-use crate::ins::{ImuSample, NavState};
+use crate::ins::error_state::{StateVector, DP, DV, N, PHI};
 
 use super::super::adaptation::Adaptation;
 use super::super::filter_state::FilterState;
@@ -44,31 +43,7 @@ impl MeasurementModel for Reported {
 }
 
 fn moving_state(p_velocity_m2_s2: f64) -> FilterState {
-    let imu = ImuSample {
-        t_s: 0.0,
-        w_ib_b_rad_s: Vector3::zeros(),
-        f_ib_b_m_s2: Vector3::new(0.0, 0.0, 9.8),
-    };
-    FilterState {
-        nav: NavState {
-            t_s: 0.0,
-            p: Llh::from_degrees(39.1, 117.2, 20.0),
-            v_n: Vector3::new(0.5, -0.2, 0.1),
-            q_nb: UnitQuaternion::identity(),
-        },
-        gyro_bias_rad_s: Vector3::zeros(),
-        gyro_markov_rad_s: Vector3::zeros(),
-        accel_bias_m_s2: Vector3::zeros(),
-        clock_bias_m: 0.0,
-        clock_drift_mps: 0.0,
-        wheel_scale_factor: 1.0,
-        gyro_scale_error: Vector3::zeros(),
-        accel_scale_error: Vector3::zeros(),
-        p: StateMatrix::identity() * p_velocity_m2_s2,
-        prev_increment: None,
-        last_imu: imu,
-        phase_anchor: None,
-    }
+    FilterState::moving(p_velocity_m2_s2)
 }
 
 fn run(variant: FilterVariant) -> (FilterState, EpochReport) {

@@ -15,12 +15,15 @@ impl RosAdapter {
     /// the `odom → base` transforms heard and the Odometry messages without a
     /// `map → odom`, once running, the filter's 3D position sigma
     /// (level ERROR when it is not finite) and the scale factors it estimates; level ERROR
-    /// from a divergence until the filter runs again, WARN while initializing or while a
+    /// from a divergence until the filter runs again, WARN while initializing, while the
+    /// heading is split into hypotheses (its σ beyond the filter's linear range) or while a
     /// second frame sends on `imu`.
     pub fn diagnostics(&self, node_name: &str, stamp: Time) -> DiagnosticArray {
-        let phase = match self.engine.init_phase() {
-            Some(p) => format!("initializing ({p:?})"),
-            None => "running".to_owned(),
+        let hypotheses = self.engine.heading_hypotheses();
+        let phase = match (self.engine.init_phase(), hypotheses) {
+            (Some(p), _) => format!("initializing ({p:?})"),
+            (None, 0) => "running".to_owned(),
+            (None, n) => format!("running, heading split into {n} hypotheses"),
         };
         let mut values = vec![
             key_value("variant", self.engine.variant_name().to_owned()),
@@ -93,6 +96,8 @@ impl RosAdapter {
                     )
                 } else if let Some(conflict) = self.imu_frame_conflict() {
                     (DiagnosticStatus::WARN, conflict)
+                } else if hypotheses > 0 {
+                    (DiagnosticStatus::WARN, phase)
                 } else {
                     (DiagnosticStatus::OK, phase)
                 }
