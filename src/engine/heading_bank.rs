@@ -327,21 +327,8 @@ impl HeadingBank {
     /// the weighted sum of their covariances and spreads about that mean. Used by a split,
     /// whose hypotheses differ in every state correlated with the heading.
     fn moment_matched(&self) -> Option<FilterState> {
-        let best_ll = self
-            .hypotheses
-            .iter()
-            .map(|h| h.log_likelihood)
-            .fold(f64::NEG_INFINITY, f64::max);
-        let best = self
-            .hypotheses
-            .iter()
-            .find(|h| h.log_likelihood == best_ll)?;
-        let weights: Vec<f64> = self
-            .hypotheses
-            .iter()
-            .map(|h| (h.log_likelihood - best_ll).exp())
-            .collect();
-        let total: f64 = weights.iter().sum();
+        let (weights, best_index) = self.weights()?;
+        let best = &self.hypotheses[best_index];
         let offsets: Vec<StateVector> = self
             .hypotheses
             .iter()
@@ -350,12 +337,12 @@ impl HeadingBank {
         let mean = offsets
             .iter()
             .zip(&weights)
-            .fold(StateVector::zeros(), |sum, (dx, w)| sum + dx * (w / total));
+            .fold(StateVector::zeros(), |sum, (dx, w)| sum + dx * *w);
         let p = self.hypotheses.iter().zip(&offsets).zip(&weights).fold(
             StateMatrix::zeros(),
             |sum, ((h, dx), w)| {
                 let d = dx - mean;
-                sum + (h.state.p + d * d.transpose()) * (w / total)
+                sum + (h.state.p + d * d.transpose()) * *w
             },
         );
         let mut state = best.state.clone();
@@ -364,25 +351,31 @@ impl HeadingBank {
         Some(state)
     }
 
-    /// The bank as one state: the best hypothesis, its heading variance grown by the
-    /// weighted spread of the hypotheses' headings about it (moment matching of the
-    /// Gaussian sum about the best), so the covariance covers what the bank has not decided.
-    fn collapsed(&self) -> Option<Collapsed> {
+    /// The hypotheses' weights (their likelihoods, normalized) and the best one's index.
+    fn weights(&self) -> Option<(Vec<f64>, usize)> {
         let best_ll = self
             .hypotheses
             .iter()
             .map(|h| h.log_likelihood)
             .fold(f64::NEG_INFINITY, f64::max);
-        let weights: Vec<f64> = self
+        let relative: Vec<f64> = self
             .hypotheses
             .iter()
             .map(|h| (h.log_likelihood - best_ll).exp())
             .collect();
-        let total: f64 = weights.iter().sum();
-        let (best_index, best_weight) = weights
+        let total: f64 = relative.iter().sum();
+        let (best_index, _) = relative
             .iter()
             .enumerate()
             .max_by(|a, b| a.1.total_cmp(b.1))?;
+        Some((relative.iter().map(|w| w / total).collect(), best_index))
+    }
+
+    /// The bank as one state: the best hypothesis, its heading variance grown by the
+    /// weighted spread of the hypotheses' headings about it (moment matching of the
+    /// Gaussian sum about the best), so the covariance covers what the bank has not decided.
+    fn collapsed(&self) -> Option<Collapsed> {
+        let (weights, best_index) = self.weights()?;
         let best = &self.hypotheses[best_index].state;
         let yaw = |s: &FilterState| s.nav.q_nb.euler_angles().2;
         let spread: f64 = self
@@ -391,7 +384,7 @@ impl HeadingBank {
             .zip(&weights)
             .map(|(h, w)| {
                 let d = wrap_pi(yaw(&h.state) - yaw(best));
-                w / total * d * d
+                w * d * d
             })
             .sum();
         let mut state = best.clone();
@@ -400,7 +393,7 @@ impl HeadingBank {
             state,
             spread,
             best_heading_variance: best.p[(PHI + 2, PHI + 2)],
-            best_share: best_weight / total,
+            best_share: weights[best_index],
         })
     }
 }
