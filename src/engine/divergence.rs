@@ -32,6 +32,14 @@
 //!   After an outage there is no epoch before to compare with, and the drift of the
 //!   outage is judged as above.
 //!
+//! While such a disagreement after a GNSS leap lasts, one of the two is wrong and the
+//! monitor cannot tell which: it is a dispute ([`DivergenceMonitor::dispute_offset_enu_m`]),
+//! and the engine widens the covariance it publishes by the offset's outer product, so
+//! that either answer lies within it (the filter's own covariance, which the updates use,
+//! is left alone), and `/diagnostics` warns. Limit: a filter that has followed a
+//! confidently wrong GNSS all the way agrees with it again, and the dispute ends; its
+//! error is then beyond the published covariance (measured in docs/results.md).
+//!
 //! A wrong filter and the GNSS agreeing on that are what divergence is; one epoch that
 //! cannot be judged (no independent position) ends the run. Limits: a GNSS that is
 //! confidently wrong from the first epoch after an outage is taken for the truth; a
@@ -158,6 +166,9 @@ pub struct DivergenceMonitor {
     previous: Option<Previous>,
     /// The current disagreement began with a GNSS jump: no run until an epoch agrees.
     gnss_jumped: bool,
+    /// The offset of the last epoch checked, GNSS less filter (m), when it disagreed
+    /// after a GNSS jump.
+    dispute_offset_enu_m: Option<Vector3<f64>>,
 }
 
 impl DivergenceMonitor {
@@ -168,6 +179,7 @@ impl DivergenceMonitor {
         let judged = epoch.and_then(|d| Some((d, d.sigmas()?)));
         let disagreeing = judged.filter(|(_, s)| *s > DISAGREE_SIGMA).map(|(d, _)| d);
         let previous = self.previous.filter(|p| t_s - p.t_s <= MAX_EPOCH_GAP_S);
+        self.dispute_offset_enu_m = None;
         self.previous = Some(Previous {
             t_s,
             judged: judged.map(|(d, _)| *d),
@@ -193,6 +205,7 @@ impl DivergenceMonitor {
         }
         if self.gnss_jumped {
             self.run = None;
+            self.dispute_offset_enu_m = Some(d.offset_enu_m);
             return false;
         }
         let continues = self.run.filter(|run| {
@@ -215,6 +228,13 @@ impl DivergenceMonitor {
         };
         self.run = Some(run);
         run.epochs >= MIN_EPOCHS && run.last_t_s - run.first_t_s >= MIN_SPAN_S
+    }
+
+    /// The GNSS position less the filter's (ENU, m) at the last epoch checked, when it
+    /// disagreed after a GNSS leap that the IMU does not support: who is wrong is not
+    /// known (see the module documentation). None otherwise.
+    pub fn dispute_offset_enu_m(&self) -> Option<Vector3<f64>> {
+        self.dispute_offset_enu_m
     }
 
     /// Forgets everything (after a reset).
@@ -276,28 +296,42 @@ mod tests {
             })
             .collect();
         assert_eq!(verdicts, [false, false, false, false, true, true]);
-        // The same leap with the velocities agreeing is the GNSS's: no divergence.
+        assert_eq!(
+            monitor.dispute_offset_enu_m(),
+            None,
+            "a divergence is no dispute"
+        );
+        // The same leap with the velocities agreeing is the GNSS's: no divergence, but a
+        // dispute while it lasts.
         let mut monitor = DivergenceMonitor::default();
         for k in 0..6 {
             let t_s = f64::from(k);
+            let east_m = if k == 0 { 0.5 } else { 20.0 };
             let d = Disagreement {
                 velocity_sigmas: Some(1.0),
-                ..epoch(t_s, if k == 0 { 0.5 } else { 20.0 })
+                ..epoch(t_s, east_m)
             };
             assert!(!monitor.check(t_s, Some(&d)));
+            let disputed = (k > 0).then(|| Vector3::new(east_m, 0.0, 0.0));
+            assert_eq!(monitor.dispute_offset_enu_m(), disputed, "epoch {k}");
         }
+        // An epoch that agrees ends it.
+        assert!(!check(&mut monitor, 6.0, 1.0));
+        assert_eq!(monitor.dispute_offset_enu_m(), None);
     }
 
     #[test]
     fn outliers_jumps_gaps_and_unjudged_epochs_start_no_divergence() {
         let mut monitor = DivergenceMonitor::default();
-        // Outliers in turning directions: the GNSS is not consistent with itself.
+        // Outliers in turning directions: the GNSS is not consistent with itself. None
+        // comes after an agreeing epoch: no dispute either.
         for k in 0..10 {
             let t_s = f64::from(k);
             let mut outlier = epoch(t_s, 0.0);
             let turn_rad = t_s * 1.2;
             outlier.offset_enu_m = Vector3::new(turn_rad.cos(), turn_rad.sin(), 0.0) * 30.0;
             assert!(!monitor.check(t_s, Some(&outlier)));
+            assert_eq!(monitor.dispute_offset_enu_m(), None);
         }
         // Within 5σ, then the GNSS jumps 45 σ away and stays there: no divergence.
         for k in 10..40 {

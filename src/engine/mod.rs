@@ -46,7 +46,9 @@
 //! - Each GNSS input seen for the first time feeds the divergence monitor ([`divergence`],
 //!   [`recovery`]) with the prior's disagreement with an independent GNSS position; a
 //!   sustained one is counted and resets the filter; unlike after an IMU gap nothing is
-//!   kept: the start-up aligns again, with a wide gyro bias prior.
+//!   kept: the start-up aligns again, with a wide gyro bias prior. While the GNSS and the
+//!   filter disagree after a GNSS leap that the IMU does not support (a dispute), the
+//!   solutions are published with their position covariance widened by the offset.
 
 mod adaptation;
 pub mod adaptive_noise;
@@ -72,6 +74,8 @@ pub mod update;
 mod wheel_odometry;
 
 use std::collections::VecDeque;
+
+use nalgebra::Vector3;
 
 use crate::config::{Config, Coupling};
 use crate::filter::process_model::{ClockNoise, ImuScaleNoise, ProcessNoise};
@@ -329,6 +333,21 @@ impl Engine {
             Phase::Aligning(bank) => bank.published(),
             Phase::Initializing(_) => None,
         }
+    }
+
+    /// The solution of the published state as published: with its position covariance
+    /// widened while the divergence monitor holds a dispute (see
+    /// [`Engine::gnss_dispute_offset_enu_m`]). None before the start.
+    pub fn published_solution(&self) -> Option<Solution> {
+        let state = self.state()?;
+        Some(recovery::published_solution(state, &self.monitor))
+    }
+
+    /// The GNSS position less the filter's (ENU, m) while the GNSS and the filter disagree
+    /// after a GNSS leap that the IMU does not support ([`divergence`]): one of them is
+    /// wrong, and the published covariance is widened by it.
+    pub fn gnss_dispute_offset_enu_m(&self) -> Option<Vector3<f64>> {
+        self.monitor.dispute_offset_enu_m()
     }
 
     /// The heading hypotheses of a split of the running filter (see [`heading_bank`]), 0
@@ -715,7 +734,8 @@ impl Engine {
                 if let Some(published) = bank.published() {
                     let t_s = published.last_imu.t_s;
                     if output_due(self.config.output.rate_hz, &mut self.last_output_t_s, t_s) {
-                        out.push(Output::Solution(Box::new(published.solution())));
+                        let solution = recovery::published_solution(published, &self.monitor);
+                        out.push(Output::Solution(Box::new(solution)));
                     }
                 }
             }
@@ -747,7 +767,8 @@ impl Engine {
                 // published: the solutions of a start it found.
                 let t_s = state.last_imu.t_s;
                 if output_due(self.config.output.rate_hz, &mut self.last_output_t_s, t_s) {
-                    out.push(Output::Solution(Box::new(state.solution())));
+                    let solution = recovery::published_solution(state, &self.monitor);
+                    out.push(Output::Solution(Box::new(solution)));
                 }
                 let moving = state.nav.v_n.xy().norm() >= self.config.init.heading_min_speed_mps;
                 if let Some(bank) = moving

@@ -33,6 +33,20 @@ impl Solution {
         position_covariance_enu_m2(&self.nav.p, &self.covariance)
     }
 
+    /// Adds the outer product of `offset_enu_m` (m) to the position covariance, as the
+    /// (δL, δλ, δh) block holds it: the solution may be off by that much beyond its own
+    /// covariance.
+    pub fn widen_position_by(&mut self, offset_enu_m: &Vector3<f64>) {
+        let (north, east) = earth::metres_per_radian(&self.nav.p);
+        let d = Vector3::new(
+            offset_enu_m.y / north,
+            offset_enu_m.x / east,
+            offset_enu_m.z,
+        );
+        let mut block = self.covariance.fixed_view_mut::<3, 3>(DP, DP);
+        block += d * d.transpose();
+    }
+
     /// Covariance of the ENU velocity ((m/s)²).
     pub fn velocity_covariance_enu_m2_s2(&self) -> Matrix3<f64> {
         self.covariance.fixed_view::<3, 3>(DV, DV).into()

@@ -4,9 +4,9 @@
 
 use nalgebra::Matrix3;
 
-use super::divergence::{Disagreement, GnssVelocityEnu};
+use super::divergence::{Disagreement, DivergenceMonitor, GnssVelocityEnu};
 use super::filter_state::FilterState;
-use super::output::{EpochReport, SatRejection};
+use super::output::{EpochReport, SatRejection, Solution};
 use super::update::{position_covariance, sigma_model};
 use super::{initializer, Engine, Measurement, Output, ResetReason};
 use crate::config::Config;
@@ -64,6 +64,17 @@ impl Engine {
         // Nothing of the diverged state is kept (see Initializer::after_divergence).
         Some(self.reset(t_s, ResetReason::DivergedFromGnss))
     }
+}
+
+/// The solution of `state` as the engine publishes it: while the monitor holds a dispute
+/// (a GNSS leap the IMU does not support: the GNSS or the filter is wrong, it cannot tell
+/// which), its position covariance widened by the offset's outer product.
+pub(super) fn published_solution(state: &FilterState, monitor: &DivergenceMonitor) -> Solution {
+    let mut solution = state.solution();
+    if let Some(offset_enu_m) = monitor.dispute_offset_enu_m() {
+        solution.widen_position_by(&offset_enu_m);
+    }
+    solution
 }
 
 /// A GNSS position independent of the filter, and its velocity when there is one.

@@ -16,8 +16,10 @@ impl RosAdapter {
     /// `map → odom`, once running, the filter's 3D position sigma
     /// (level ERROR when it is not finite) and the scale factors it estimates; level ERROR
     /// from a divergence until the filter runs again, WARN while initializing, while the
-    /// heading is split into hypotheses (its σ beyond the filter's linear range) or while a
-    /// second frame sends on `imu`.
+    /// heading is split into hypotheses (its σ beyond the filter's linear range), while
+    /// GNSS and filter are in a dispute (`gnss_dispute_m`: the GNSS leapt from the filter
+    /// without the IMU's support, and the published covariance is widened by the offset)
+    /// or while a second frame sends on `imu`.
     pub fn diagnostics(&self, node_name: &str, stamp: Time) -> DiagnosticArray {
         let hypotheses = self.engine.heading_hypotheses();
         let phase = match (self.engine.init_phase(), hypotheses) {
@@ -73,6 +75,11 @@ impl RosAdapter {
             "late_measurements",
             self.engine.late_measurements().to_string(),
         ));
+        let dispute_m = self.engine.gnss_dispute_offset_enu_m().map(|o| o.norm());
+        values.push(key_value(
+            "gnss_dispute_m",
+            dispute_m.map_or("none".to_owned(), |m| format!("{m:.1}")),
+        ));
         let (level, message) = match (self.engine.state(), self.engine.diverged_at_t_s()) {
             (None, Some(t_s)) => (
                 DiagnosticStatus::ERROR,
@@ -85,7 +92,8 @@ impl RosAdapter {
                 self.imu_frame_conflict().unwrap_or(phase),
             ),
             (Some(state), _) => {
-                let trace_m2 = state.solution().position_covariance_enu_m2().trace();
+                let solution = (self.engine.published_solution()).unwrap_or_else(|| state.solution());
+                let trace_m2 = solution.position_covariance_enu_m2().trace();
                 let sigma_m = sigma_of_variance(trace_m2);
                 values.push(key_value("position_sigma_3d_m", format!("{sigma_m:.3}")));
                 values.extend(scale_factor_values(state, self.engine.config()));
@@ -96,6 +104,13 @@ impl RosAdapter {
                     )
                 } else if let Some(conflict) = self.imu_frame_conflict() {
                     (DiagnosticStatus::WARN, conflict)
+                } else if let Some(dispute_m) = dispute_m {
+                    (
+                        DiagnosticStatus::WARN,
+                        format!(
+                            "{phase}; GNSS leapt {dispute_m:.1} m from the filter without the IMU's support: one of them is wrong, position covariance widened by it"
+                        ),
+                    )
                 } else if hypotheses > 0 {
                     (DiagnosticStatus::WARN, phase)
                 } else {

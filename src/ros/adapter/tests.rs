@@ -829,6 +829,54 @@ fn a_divergence_is_an_error_on_diagnostics_until_the_filter_runs_again() {
     );
 }
 
+/// Fixes that leap 60 m up without the IMU's support (no outage before, the filter at
+/// rest): a dispute, WARN with the offset while it lasts, and no reset; OK again once the
+/// fixes are back.
+#[test]
+fn a_gnss_leap_is_a_warning_on_diagnostics_while_disputed() {
+    use crate::sim::SimEvent;
+    let mut adapter = loose_adapter(OutputFrames::default());
+    let leap = 30.5..40.0;
+    let mut warnings = 0;
+    for_each_static_event(60.0, |event, stamp| {
+        match event {
+            SimEvent::Imu(s) => {
+                adapter.on_imu(&outbound::imu(&s, stamp, "imu"));
+            }
+            SimEvent::Fix(mut f) => {
+                if leap.contains(&f.t_s) {
+                    let up = nalgebra::Vector3::new(0.0, 0.0, 60.0);
+                    f.position = crate::earth::enu_to_llh(&up, &f.position).unwrap();
+                }
+                adapter.on_fix(&outbound::receiver_fix(&f, stamp, "gnss"));
+            }
+            _ => {}
+        }
+        if adapter.engine().gnss_dispute_offset_enu_m().is_some() {
+            let (level, message) = level(&adapter);
+            assert_eq!(level, DiagnosticStatus::WARN, "{message}");
+            let dispute_m: f64 = diagnostic(&adapter, "gnss_dispute_m")
+                .unwrap()
+                .parse()
+                .unwrap();
+            assert!((40.0..70.0).contains(&dispute_m), "{dispute_m} m");
+            warnings += 1;
+        }
+    });
+    assert!(warnings > 0, "no dispute");
+    assert_eq!(adapter.engine().divergence_resets(), 0);
+    assert_eq!(
+        diagnostic(&adapter, "gnss_dispute_m").as_deref(),
+        Some("none")
+    );
+    assert_eq!(
+        level(&adapter).0,
+        DiagnosticStatus::OK,
+        "{:?}",
+        level(&adapter)
+    );
+}
+
 /// Issue 15: with `gnss.tdcp` the phase changes used and left out show on /diagnostics;
 /// a satellite whose half cycle is never resolved is counted under its reason every
 /// epoch, and without `gnss.tdcp` there are no such keys.
