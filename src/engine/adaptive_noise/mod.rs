@@ -177,9 +177,14 @@ impl NoiseModel {
     /// The covariance of a measurement whose noise is one matrix (a receiver fix). Only
     /// the residual-based strategy estimates it, one window per kind of measurement; the
     /// others are per-satellite strategies and give `nominal` back.
-    pub fn joint_covariance(&self, kind: MeasurementKind, nominal: &DMatrix<f64>) -> DMatrix<f64> {
+    pub fn joint_covariance(
+        &self,
+        kind: MeasurementKind,
+        t_s: f64,
+        nominal: &DMatrix<f64>,
+    ) -> DMatrix<f64> {
         match self {
-            Self::Residual(m) => m.joint_covariance(kind, nominal),
+            Self::Residual(m) => m.joint_covariance(kind, t_s, nominal),
             Self::Fixed | Self::Innovation(_) | Self::Redundant(_) => nominal.clone(),
         }
     }

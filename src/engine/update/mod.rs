@@ -241,7 +241,8 @@ impl<M: MeasurementModel> Step<'_, M> {
         outliers: Option<(&[usize], f64)>,
     ) -> Result<(), FilterError> {
         let kind = self.model.kind();
-        let mut r = self.adaptation.noise.joint_covariance(kind, r_nominal);
+        let t_s = self.model.t_s();
+        let mut r = self.adaptation.noise.joint_covariance(kind, t_s, r_nominal);
         self.report.q_scale = self.adaptation.q.scale();
         let y = innovations(lin);
         if let (MeasurementKind::Fix, Some((block_lengths, _))) = (kind, outliers) {
