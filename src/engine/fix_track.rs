@@ -32,6 +32,8 @@ use super::update::{position_covariance, GnssFix};
 pub const MAX_BASELINE_S: f64 = 5.0;
 /// Residual (in σ of its fix) beyond which a fix is dropped from the fit.
 pub const OUTLIER_SIGMA: f64 = 4.0;
+/// The median of χ²(1).
+const CHI2_1_MEDIAN: f64 = 0.454_936;
 
 /// A line fitted to the recent fixes.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -91,16 +93,17 @@ impl FixTrack {
             .collect();
         loop {
             let line = Line::fit(&points)?;
+            let optimism = line.optimism(&points);
             let worst = points
                 .iter()
                 .enumerate()
                 .map(|(i, (t, x, sigma))| (i, line.residual(*t, x).component_div(sigma).amax()))
                 .max_by(|a, b| a.1.total_cmp(&b.1));
             match worst {
-                Some((i, r)) if r > OUTLIER_SIGMA && points.len() > 3 => {
+                Some((i, r)) if r > OUTLIER_SIGMA * optimism.sqrt() && points.len() > 3 => {
                     points.remove(i);
                 }
-                _ => return Some(line.at(newest)),
+                _ => return Some(line.at(newest, optimism)),
             }
         }
     }
@@ -164,13 +167,48 @@ impl Line {
         x - self.a - self.b * t
     }
 
-    fn at(&self, newest: &GnssFix) -> TrackFit {
+    /// How much the fixes scatter about the line beyond what they claim: the factor on
+    /// their variances (at least 1) that their horizontal residuals call for.
+    ///
+    /// Choice: the median of the squared normalized residuals over the median of χ²(1)
+    /// (0.455), times n/(n − 2) for the two parameters the line took from n fixes (a
+    /// robust reduced χ², which one outlier does not inflate); at least 1, so honest
+    /// claims are kept, and 1 below three fixes. A receiver claiming a fifth of its error
+    /// otherwise made a start at rest see motion and take a heading 80° off with a σ of 5°
+    /// (tests/fix_consistency.rs).
+    fn optimism(&self, points: &[(f64, Vector3<f64>, Vector3<f64>)]) -> f64 {
+        let n = points.len();
+        if n < 3 {
+            return 1.0;
+        }
+        let mut squares: Vec<f64> = points
+            .iter()
+            .flat_map(|(t, x, sigma)| {
+                let r = self.residual(*t, x).component_div(sigma);
+                [r.x * r.x, r.y * r.y]
+            })
+            .collect();
+        squares.sort_by(f64::total_cmp);
+        let m = squares.len();
+        let median = 0.5 * (squares[(m - 1) / 2] + squares[m / 2]);
+        let factor = median / CHI2_1_MEDIAN * n as f64 / (n - 2) as f64;
+        if factor.is_finite() {
+            factor.max(1.0)
+        } else {
+            1.0
+        }
+    }
+
+    /// The fit at the newest fix, its covariances scaled by `optimism`.
+    fn at(&self, newest: &GnssFix, optimism: f64) -> TrackFit {
+        let var_a = self.var_a * optimism;
+        let var_b = self.var_b * optimism;
         TrackFit {
             t_s: newest.t_s,
             position: earth::enu_to_llh(&self.a, &newest.position).unwrap_or(newest.position),
-            position_var_m2: self.var_a.sum() / 3.0,
+            position_var_m2: var_a.sum() / 3.0,
             v_enu_mps: self.b,
-            cov_v_h_m2_s2: Matrix2::new(self.var_b[0], 0.0, 0.0, self.var_b[1]),
+            cov_v_h_m2_s2: Matrix2::new(var_b[0], 0.0, 0.0, var_b[1]),
             lag_s: -self.mean_t,
             quadratic_lag_s2: -0.5 * self.t2_line_at_0,
         }
