@@ -39,8 +39,9 @@
 //!   off by more than its P⁻ says has every prior innovation refused, so the R̂ it learned
 //!   before stayed, and a large one (learned in a street canyon) kept the good fixes that
 //!   followed from pulling it back: measured on tests/data/consumer_mems_drive.yaml, the
-//!   vertical RMS over 320–340 s was 45.6 m against the EKF's 0.8 m. While it is refused
-//!   the filter is now the EKF of the receiver's claim (docs/results.md).
+//!   vertical RMS over 320–340 s was 45.6 m against the EKF's 0.8 m. After that gap of
+//!   refusals the filter is now the EKF of the receiver's claim, until a new window is
+//!   full (docs/results.md).
 
 use std::collections::hash_map::Entry;
 use std::collections::HashMap;
