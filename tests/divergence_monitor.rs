@@ -23,6 +23,10 @@ use adaptive_gnss_ins::eval;
 use adaptive_gnss_ins::gnss::GnssEpoch;
 use adaptive_gnss_ins::ins::error_state::PHI;
 use adaptive_gnss_ins::ins::ImuSample;
+use adaptive_gnss_ins::ros::adapter::{OutputFrames, RosAdapter};
+use adaptive_gnss_ins::ros::convert::seconds_to_time;
+use adaptive_gnss_ins::ros::msg::DiagnosticStatus;
+use adaptive_gnss_ins::ros::outbound;
 use adaptive_gnss_ins::sim::constellation::GpsConstellation;
 use adaptive_gnss_ins::sim::{ImuErrorModel, ImuErrorSpec, Trajectory};
 use nalgebra::Vector3;
@@ -444,4 +448,51 @@ fn a_gyro_bias_jump_loosely_coupled_without_a_constraint_splits_the_heading() {
         assert!(r.scored > 60, "{variant:?}: {r:?}");
         assert!(r.worst_split_yaw_sigmas <= 3.0, "{variant:?}: {r:?}");
     }
+}
+
+/// The split of [`a_gyro_bias_jump_loosely_coupled_without_a_constraint_splits_the_heading`]
+/// as the node reports it: the same drive played through the ROS adapter (sensor_msgs/Imu
+/// and NavSatFix as a driver sends them); while the heading is split `/diagnostics` says
+/// WARN with the number of hypotheses, and OK once one filter runs again.
+#[test]
+fn a_heading_split_is_a_warning_on_diagnostics() {
+    let imu_spec = consumer_mems_imu();
+    let trajectory = Trajectory::new(&drive(1)).unwrap();
+    let mut imu = ImuErrorModel::new(&imu_spec, 100.0, 42).unwrap();
+    let gyro_step_rad_s = Vector3::from(imu_spec.gyro_bias_deg_per_h) * (9.0 * DEG_PER_H_RAD_S);
+    let mut fixes = Fixes::new(WHITE_FIXES, 3);
+    let mut config = consumer_mems_config();
+    config.filter.coupling = Coupling::Loose;
+    let mut adapter = RosAdapter::new(config, OutputFrames::default());
+    let (mut warned_split, mut ok_after_split) = (0, 0);
+    for truth in trajectory.samples(100.0).unwrap() {
+        let t = truth.nav.t_s;
+        let stamp = seconds_to_time(t).unwrap();
+        let mut measured = imu.corrupt(&truth.imu);
+        if t >= GYRO_STEP_AT_S {
+            measured.w_ib_b_rad_s += gyro_step_rad_s;
+        }
+        adapter.on_imu(&outbound::imu(&measured, stamp, "imu"));
+        if (t - t.round()).abs() > 1e-9 {
+            continue;
+        }
+        adapter.on_fix(&outbound::receiver_fix(
+            &fixes.fix(&truth.nav),
+            stamp,
+            "gnss",
+        ));
+        let status = &adapter.diagnostics("/ins", stamp).status[0];
+        let hypotheses = adapter.engine().heading_hypotheses();
+        if hypotheses > 0 {
+            assert_eq!(status.level, DiagnosticStatus::WARN, "{}", status.message);
+            let phase = format!("running, heading split into {hypotheses} hypotheses");
+            assert!(status.message.contains(&phase), "{}", status.message);
+            warned_split += 1;
+        } else if warned_split > 0 && adapter.engine().state().is_some() {
+            ok_after_split += usize::from(status.level == DiagnosticStatus::OK);
+        }
+    }
+    println!("{warned_split} epochs split and warned, {ok_after_split} OK after");
+    assert!(warned_split > 0, "no split");
+    assert!(ok_after_split > 0, "never OK again after the split");
 }
