@@ -9,6 +9,7 @@
 use adaptive_gnss_ins::config::{Config, Coupling};
 use adaptive_gnss_ins::engine::Engine;
 use adaptive_gnss_ins::eval;
+use adaptive_gnss_ins::ins::error_state::PHI;
 use adaptive_gnss_ins::sim::{ImuErrorModel, ImuErrorSpec, Trajectory};
 use nalgebra::Matrix3;
 use statrs::distribution::{ChiSquared, ContinuousCDF};
@@ -37,7 +38,14 @@ struct Run {
     rescaled: u64,
 }
 
-fn run(claimed_m: f64, judged: bool) -> Run {
+/// Plays the drive loosely coupled with the default IMU and fixes erring [`ERROR_M`]
+/// that claim `claim_m(t)` (m), the judge on when `judged`; after each fix calls `at_fix`
+/// with its time, the engine and the truth. Returns the engine.
+fn drive_with_claims(
+    judged: bool,
+    claim_m: impl Fn(f64) -> f64,
+    mut at_fix: impl FnMut(f64, &Engine, &eval::TruthSample),
+) -> Engine {
     let trajectory = Trajectory::new(&drive(1)).unwrap();
     let mut imu = ImuErrorModel::new(&ImuErrorSpec::default(), 100.0, 42).unwrap();
     let noise = FixNoise {
@@ -49,8 +57,6 @@ fn run(claimed_m: f64, judged: bool) -> Run {
     config.filter.coupling = Coupling::Loose;
     config.loose.fix_consistency = judged;
     let mut engine = Engine::new(config);
-    let bound = ChiSquared::new(9.0).unwrap().inverse_cdf(0.95);
-    let (mut scored, mut inside) = (0, 0);
     for truth in trajectory.samples(100.0).unwrap() {
         let t = truth.nav.t_s;
         engine.push_imu(&imu.corrupt(&truth.imu)).unwrap();
@@ -58,24 +64,33 @@ fn run(claimed_m: f64, judged: bool) -> Run {
             continue;
         }
         let mut fix = fixes.fix(&truth.nav);
-        let claim_m = if t < MISCLAIM_FROM_S {
+        fix.position_covariance_enu_m2 = Some(Matrix3::identity() * claim_m(t).powi(2));
+        engine.push_fix(fix).unwrap();
+        at_fix(t, &engine, &eval::TruthSample::from(&truth.nav));
+    }
+    engine
+}
+
+fn run(claimed_m: f64, judged: bool) -> Run {
+    let bound = ChiSquared::new(9.0).unwrap().inverse_cdf(0.95);
+    let (mut scored, mut inside) = (0, 0);
+    let claim_m = |t: f64| {
+        if t < MISCLAIM_FROM_S {
             ERROR_M
         } else {
             claimed_m
-        };
-        fix.position_covariance_enu_m2 = Some(Matrix3::identity() * claim_m.powi(2));
-        engine.push_fix(fix).unwrap();
-        let Some(state) = engine.state() else {
-            continue;
-        };
-        if t < SCORED_FROM_S {
-            continue;
         }
-        let reference = eval::TruthSample::from(&truth.nav);
-        let nees = eval::solution_error(&state.solution(), &reference).nees;
-        scored += 1;
-        inside += usize::from(nees <= bound);
-    }
+    };
+    let engine = drive_with_claims(judged, claim_m, |t, engine, reference| {
+        let Some(state) = engine.state() else {
+            return;
+        };
+        if t >= SCORED_FROM_S {
+            let nees = eval::solution_error(&state.solution(), reference).nees;
+            scored += 1;
+            inside += usize::from(nees <= bound);
+        }
+    });
     assert!(scored > 100, "{scored} epochs scored");
     Run {
         inside_share: inside as f64 / scored as f64,
@@ -107,33 +122,19 @@ fn a_receiver_claiming_a_quarter_of_its_error_is_judged_and_the_filter_is_honest
 /// The yaw errors (deg) and σ (deg) of a start on a receiver erring [`ERROR_M`] that
 /// claims `claimed_m` from the first fix: (time, error, σ) at every fix while running.
 fn start_on_claim(claimed_m: f64) -> Vec<(f64, f64, f64)> {
-    let trajectory = Trajectory::new(&drive(1)).unwrap();
-    let mut imu = ImuErrorModel::new(&ImuErrorSpec::default(), 100.0, 42).unwrap();
-    let noise = FixNoise {
-        gm_sigma_m: [0.0, 0.0],
-        white_sigma_m: [ERROR_M, ERROR_M],
-    };
-    let mut fixes = Fixes::new(noise, 3);
-    let mut config = Config::default();
-    config.filter.coupling = Coupling::Loose;
-    let mut engine = Engine::new(config);
     let mut yaw = Vec::new();
-    for truth in trajectory.samples(100.0).unwrap() {
-        let t = truth.nav.t_s;
-        engine.push_imu(&imu.corrupt(&truth.imu)).unwrap();
-        if (t - t.round()).abs() > 1e-9 {
-            continue;
-        }
-        let mut fix = fixes.fix(&truth.nav);
-        fix.position_covariance_enu_m2 = Some(Matrix3::identity() * claimed_m.powi(2));
-        engine.push_fix(fix).unwrap();
-        if let Some(state) = engine.state() {
-            let reference = eval::TruthSample::from(&truth.nav);
-            let error = eval::solution_error(&state.solution(), &reference);
-            let yaw_error_deg = error.attitude_rpy_rad.unwrap()[2].to_degrees();
-            yaw.push((t, yaw_error_deg, state.p[(2, 2)].sqrt().to_degrees()));
-        }
-    }
+    drive_with_claims(
+        true,
+        |_| claimed_m,
+        |t, engine, reference| {
+            if let Some(state) = engine.state() {
+                let error = eval::solution_error(&state.solution(), reference);
+                let yaw_error_deg = error.attitude_rpy_rad.unwrap()[2].to_degrees();
+                let yaw_sigma_deg = state.p[(PHI + 2, PHI + 2)].sqrt().to_degrees();
+                yaw.push((t, yaw_error_deg, yaw_sigma_deg));
+            }
+        },
+    );
     yaw
 }
 
