@@ -1,15 +1,17 @@
 //! The filter's two hot steps: one IMU step (strapdown mechanization plus covariance
-//! propagation) and one tightly-coupled update with 12 satellites (24 measurements); and
-//! the divergence monitor's step of a loosely-coupled epoch.
+//! propagation) and one tightly-coupled update with 12 satellites (24 measurements); the
+//! divergence monitor's step of a loosely-coupled epoch; and one IMU step of a running
+//! filter whose heading is split into hypotheses.
 //! Run with `cargo bench --bench filter_steps`; the README reports the numbers.
 
 use adaptive_gnss_ins::config::{Config, FilterVariant};
 use adaptive_gnss_ins::earth::{self, Llh};
 use adaptive_gnss_ins::engine::divergence::{Disagreement, DivergenceMonitor};
+use adaptive_gnss_ins::engine::heading_bank::HeadingBank;
 use adaptive_gnss_ins::engine::update::{self, Pseudoranges};
 use adaptive_gnss_ins::engine::{process_noise, Adaptation, FilterState};
 use adaptive_gnss_ins::gnss::GnssEpoch;
-use adaptive_gnss_ins::ins::error_state::{StateMatrix, StateVector, DP, WHEEL_SCALE};
+use adaptive_gnss_ins::ins::error_state::{StateMatrix, StateVector, DP, PHI, WHEEL_SCALE};
 use adaptive_gnss_ins::ins::{ImuSample, NavState};
 use adaptive_gnss_ins::sim::constellation::{
     AtmosphereTruth, GpsConstellation, ObservationNoise, ReceiverTruth,
@@ -237,11 +239,32 @@ fn divergence_monitor_step(c: &mut Criterion) {
     });
 }
 
+/// One IMU step of a running filter whose heading σ of 20° split it into hypotheses
+/// (13, 10° apart): every hypothesis' step and the moment matching of the state it
+/// publishes.
+fn heading_split_imu_step(c: &mut Criterion) {
+    let config = Config::default();
+    let noise = process_noise(&config);
+    let mut running = running_state(Llh::from_degrees(39.1, 117.2, 20.0));
+    running.p[(PHI + 2, PHI + 2)] = 20f64.to_radians().powi(2);
+    let start = HeadingBank::split(&running, &config).expect("a split");
+    assert_eq!(start.len(), 13);
+    c.bench_function("heading_split_imu_step_13_hypotheses", |b| {
+        let mut bank = start.clone();
+        let mut next = running.last_imu;
+        b.iter(|| {
+            next.t_s += 0.01;
+            bank.propagate(black_box(&next), &noise).expect("step");
+        })
+    });
+}
+
 criterion_group!(
     benches,
     imu_step,
     tc_update,
     tc_update_adaptive,
-    divergence_monitor_step
+    divergence_monitor_step,
+    heading_split_imu_step
 );
 criterion_main!(benches);
