@@ -118,6 +118,8 @@ const EVERY_KEY_CHANGED: &str = "
       innovation_gate_sigma: 0.0
       constellations: [glonass, qzss, sbas, gps]
       clock_jump_threshold_m: 5000.0
+      error_correlation: false
+      error_correlation_max_inflation: 50.0
       tdcp: true
       tdcp_phase_sigma_m: 0.02
       tdcp_slip_threshold_m: 0.3

@@ -94,7 +94,7 @@ fn run(claimed_m: f64, judged: bool) -> Run {
     assert!(scored > 100, "{scored} epochs scored");
     Run {
         inside_share: inside as f64 / scored as f64,
-        rescaled: engine.fix_outliers().position_rescaled,
+        rescaled: engine.deweighted().position_rescaled,
     }
 }
 

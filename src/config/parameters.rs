@@ -346,6 +346,18 @@ parameter_table! {
         /// receiver clock jump (receivers jump whole milliseconds, about 300 km).
         max_clock_jump_m: f64 ["clock_jump_threshold_m": f64] = 100_000.0,
             unit "m", range Range::Within(Interval::above(0.0, 1e7)), at_run_time;
+        /// Judge each satellite's pseudo-range and rate errors over its last 20 epochs by
+        /// the filter's innovations (their part that no error common to all satellites
+        /// explains): where their lag-one autocorrelation ρ is significant, multiply the
+        /// variance by (1 + ρ)/(1 − ρ), and where their mean square is, by that too. A
+        /// filter that takes correlated errors (multipath under foliage, a facade's
+        /// reflection) for independent ones claims a precision it does not have. Counted
+        /// (correlated_measurements). false = the variances as the variant gives them
+        /// (the papers' filters).
+        error_correlation: bool = true, unit "", range ANY, at_start;
+        /// Largest factor of that inflation (a variance factor: 25 is σ × 5).
+        error_correlation_max_inflation: f64 = 25.0,
+            unit "", range Range::Within(Interval::closed(1.0, 1e6)), at_start;
         /// Fuse time-differenced carrier phase (TDCP): each satellite's phase change
         /// between consecutive epochs, a measurement of the antenna's displacement over the
         /// interval (and the receiver clock's change), applied before the epoch's

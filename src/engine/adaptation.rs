@@ -10,6 +10,7 @@ use crate::config::{AdaptiveFactorKind, Config, EquivalentWeightKind, RobustSche
 use crate::filter::robust_update::{RobustUpdate, Scheme};
 
 use super::adaptive_noise::NoiseModel;
+use super::error_correlation::ErrorCorrelation;
 use super::fix_consistency::FixConsistency;
 use super::q_scaling::QScaling;
 
@@ -27,6 +28,8 @@ pub struct Adaptation {
     /// The judges of the receiver fixes' claimed covariance (loose coupling): of the
     /// position, and of the velocity.
     pub fix: [FixConsistency; 2],
+    /// The judge of the satellites' error correlation (tight coupling).
+    pub correlation: ErrorCorrelation,
 }
 
 impl Adaptation {
@@ -38,6 +41,11 @@ impl Adaptation {
             update: robust_update(config),
             q: QScaling::new(config),
             fix: [(); 2].map(|()| FixConsistency::new(config.loose.fix_consistency)),
+            correlation: ErrorCorrelation::new(
+                config.gnss.error_correlation,
+                config.gnss.error_correlation_max_inflation,
+                config.adaptive.max_epoch_gap_s,
+            ),
         }
     }
 
@@ -46,6 +54,7 @@ impl Adaptation {
         self.noise.reset();
         self.q.reset();
         self.fix.iter_mut().for_each(FixConsistency::reset);
+        self.correlation.reset();
     }
 }
 

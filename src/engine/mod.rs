@@ -55,6 +55,7 @@ pub mod adaptive_noise;
 mod constraints;
 pub mod divergence;
 mod dual_antenna;
+mod error_correlation;
 mod filter_state;
 pub(crate) mod fix_consistency;
 mod fix_track;
@@ -95,7 +96,7 @@ pub use dual_antenna::{BaselineHeadingReading, CarrierSolution};
 pub use filter_state::{interpolate, FilterState};
 pub use initializer::{InitPhase, Initializer};
 pub use output::{
-    EpochReport, FixOutliers, MeasurementKind, Output, PhaseRejection, ResetReason, SatRejection,
+    Deweighted, EpochReport, MeasurementKind, Output, PhaseRejection, ResetReason, SatRejection,
     SatReport, Solution, StatusEvent,
 };
 pub use rejection::{InputRejected, RejectionCounters, RejectionReason};
@@ -255,7 +256,7 @@ pub struct Engine {
     divergence_resets: u64,
     /// Measurements applied after the IMU had passed their stamp, so far.
     late_measurements: u64,
-    fix_outliers: FixOutliers,
+    deweighted: Deweighted,
     /// The start since the last reset was reported.
     start_reported: bool,
     /// Time of the last divergence while the filter has not started again since.
@@ -283,7 +284,7 @@ impl Engine {
             divergence_resets: 0,
             late_measurements: 0,
             start_reported: false,
-            fix_outliers: FixOutliers::default(),
+            deweighted: Deweighted::default(),
             diverged_at_t_s: None,
         }
     }
@@ -302,9 +303,10 @@ impl Engine {
         self.constraints.updates()
     }
 
-    /// Fix positions and velocities deweighted as outliers so far.
-    pub fn fix_outliers(&self) -> FixOutliers {
-        self.fix_outliers
+    /// The measurements deweighted so far: fix outliers, fix claims scaled, pseudo-ranges
+    /// and rates inflated for correlated errors.
+    pub fn deweighted(&self) -> Deweighted {
+        self.deweighted
     }
 
     /// Resets after a divergence from GNSS so far.
@@ -863,7 +865,7 @@ impl Engine {
                                 .reject(RejectionReason::BaselineHeadingGated, t);
                         }
                         if report {
-                            self.fix_outliers.count(&epoch);
+                            self.deweighted.count(&epoch);
                         }
                         // A wheel speed or a baseline heading is no GNSS input to
                         // monitor, and gives no report (as the motion constraints).

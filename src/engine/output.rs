@@ -257,6 +257,8 @@ pub struct EpochReport {
     /// velocity's, from the fixes before (`loose.fix_consistency`; 1: taken as claimed);
     /// empty in tight coupling.
     pub fix_scales: Vec<f64>,
+    /// Pseudo-ranges and rates whose variance the error-correlation judge inflated.
+    pub correlated_measurements: usize,
     /// The report of the epoch's time-differenced carrier-phase update, applied before the
     /// pseudo-ranges (`gnss.tdcp`; None when off or without a previous epoch's phases).
     pub carrier_phase_deltas: Option<Box<EpochReport>>,
@@ -283,25 +285,30 @@ impl EpochReport {
             fix_position_outlier: false,
             fix_velocity_outlier: false,
             fix_scales: Vec::new(),
+            correlated_measurements: 0,
             carrier_phase_deltas: None,
         }
     }
 }
 
-/// The receiver fixes whose position or velocity was deweighted as an outlier
-/// (`loose.fix_outlier_sigma`), and those whose claimed position or velocity covariance
-/// was scaled (`loose.fix_consistency`), so far (shown on /diagnostics).
+/// The measurements deweighted so far (shown on /diagnostics): receiver fixes whose
+/// position or velocity was an outlier (`loose.fix_outlier_sigma`) or whose claimed
+/// position or velocity covariance was scaled (`loose.fix_consistency`), and pseudo-ranges
+/// and rates whose variance was inflated for their errors' time correlation
+/// (`gnss.error_correlation`).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct FixOutliers {
+pub struct Deweighted {
     pub position: u64,
     pub velocity: u64,
     pub position_rescaled: u64,
     pub velocity_rescaled: u64,
+    pub correlated: u64,
 }
 
-impl FixOutliers {
-    /// Counts the outliers of the fix update `report`.
+impl Deweighted {
+    /// Counts the deweighted measurements of the update `report`.
     pub fn count(&mut self, report: &EpochReport) {
+        self.correlated += report.correlated_measurements as u64;
         self.position += u64::from(report.fix_position_outlier);
         self.velocity += u64::from(report.fix_velocity_outlier);
         let rescaled =

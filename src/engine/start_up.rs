@@ -143,7 +143,7 @@ impl Engine {
         }
         let gnss = matches!(m, Measurement::Gnss(_) | Measurement::Fix(_));
         if let Some(epoch) = epoch.filter(|_| report && gnss && bank.published().is_some()) {
-            self.fix_outliers.count(&epoch);
+            self.deweighted.count(&epoch);
             out.push(Output::Epoch(epoch));
         }
         if let Some(state) = bank.resolved(t) {

@@ -59,10 +59,11 @@ use crate::filter::measurement_rows::row_variance;
 use crate::filter::process_model::ProcessNoise;
 use crate::filter::robust_update::{ErrorStateModel, MeasurementSet};
 use crate::gnss::GnssEpoch;
-use crate::ins::error_state::{StateVector, N};
+use crate::ins::error_state::{StateVector, CLOCK_BIAS, CLOCK_DRIFT, DP, DV, N};
 
 use super::adaptation::Adaptation;
-use super::adaptive_noise::ScalarMeasurement;
+use super::adaptive_noise::{Observable, ScalarMeasurement};
+use super::error_correlation::ChannelInnovation;
 use super::filter_state::FilterState;
 use super::fix_consistency;
 use super::output::{EpochReport, MeasurementKind};
@@ -190,6 +191,8 @@ impl<M: MeasurementModel> Step<'_, M> {
             self.model.report_noise(&mut self.report, i, verdict);
         }
         let y = innovations(lin);
+        let correlated = self.judge_correlation(lin, channels, &y, &r);
+        self.report.correlated_measurements = correlated.iter().filter(|&&f| f > 1.0).count();
         let gate_rows: Vec<GateRow> = (0..m)
             .map(|i| GateRow {
                 row: &lin.rows[i],
@@ -209,7 +212,7 @@ impl<M: MeasurementModel> Step<'_, M> {
         if !kept.is_empty() {
             let mut r_kept = DMatrix::zeros(kept.len(), kept.len());
             for (j, &i) in kept.iter().enumerate() {
-                r_kept[(j, j)] = r[i];
+                r_kept[(j, j)] = r[i] * correlated[i];
             }
             self.correct(state, Rows::select(lin, &y, &kept), r_kept)?;
         }
@@ -228,6 +231,46 @@ impl<M: MeasurementModel> Step<'_, M> {
             noise.after_update(t_s, &scalars, posterior.as_slice(), &posterior_hph);
         }
         Ok(())
+    }
+
+    /// The factor on each row's variance `r` for its channel's error correlation
+    /// ([`super::error_correlation`]), from the epochs before; then the judge takes this
+    /// epoch's innovations `y` (unless re-applied after a roll-back).
+    fn judge_correlation(
+        &mut self,
+        lin: &Linearization,
+        channels: &[NoiseChannel],
+        y: &[f64],
+        r: &[f64],
+    ) -> Vec<f64> {
+        let t_s = self.model.t_s();
+        let judge = &mut self.adaptation.correlation;
+        let factors = channels
+            .iter()
+            .map(|c| judge.inflation(c.sat, c.observable, t_s))
+            .collect();
+        if self.learn {
+            let epoch: Vec<ChannelInnovation> = channels
+                .iter()
+                .enumerate()
+                .map(|(i, c)| {
+                    let (first, clock) = match c.observable {
+                        Observable::Pseudorange => (DP, CLOCK_BIAS),
+                        Observable::PseudorangeRate => (DV, CLOCK_DRIFT),
+                    };
+                    let row = &lin.rows[i];
+                    ChannelInnovation {
+                        sat: c.sat,
+                        observable: c.observable,
+                        y: y[i],
+                        r: r[i],
+                        common: [row[first], row[first + 1], row[first + 2], row[clock]],
+                    }
+                })
+                .collect();
+            judge.push(t_s, &epoch);
+        }
+        factors
     }
 
     /// A measurement whose noise is one matrix: updated as a whole (its outlying blocks

@@ -40,7 +40,7 @@ impl RosAdapter {
             }
         }
         let updates = self.engine.constraint_updates();
-        let outliers = self.engine.fix_outliers();
+        let outliers = self.engine.deweighted();
         for (key, n) in [
             ("updates_zero_velocity", updates.zero_velocity),
             ("updates_zero_rate", updates.zero_rate),
@@ -49,6 +49,7 @@ impl RosAdapter {
             ("fix_velocity_outliers", outliers.velocity),
             ("fix_position_rescaled", outliers.position_rescaled),
             ("fix_velocity_rescaled", outliers.velocity_rescaled),
+            ("correlated_measurements", outliers.correlated),
         ] {
             values.push(key_value(key, n.to_string()));
         }

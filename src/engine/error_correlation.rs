@@ -1,0 +1,347 @@
+//! The time correlation of each satellite's measurement errors, judged from the filter's
+//! innovations, and the inflation of R it calls for (tight coupling,
+//! `gnss.error_correlation`).
+//!
+//! A Kalman filter takes each epoch's measurement error as new. Multipath under foliage or
+//! a facade's reflection persists for seconds to minutes, so averaging n epochs of it does
+//! not shrink it by √n, while the filter's covariance does: on the simulated default drive
+//! every variant left the foliage with its heading 1–3° off at a claimed σ of 0.1–0.3°,
+//! and carried that for the next 250 s of open sky (docs/results.md).
+//!
+//! Per channel (satellite and observable) the judge keeps the last epochs' parity
+//! residuals of the innovations: what no error common to all satellites explains (a fit of
+//! the rows' position — or velocity — and clock columns, [`scaled_residuals`]), so the
+//! filter's own state error, which every satellite sees through its line of sight, is not
+//! charged to the satellites; each divided by √R. From them the lag-one autocorrelation
+//! ρ̂ = Σ xₖxₖ₋₁ / √(Σ xₖ² Σ xₖ₋₁²) over consecutive epochs.
+//!
+//! Choice (the inflation): when ρ̂ exceeds its 99 % quantile under white errors
+//! ([`Z_99`] / √pairs), R is multiplied by (1 + ρ̂)/(1 − ρ̂): the variance of the mean of
+//! n epochs of AR(1) errors is that of n(1 − ρ)/(1 + ρ) independent ones, so the filter's
+//! averaging is charged what it really gains. When the mean square of the normalised
+//! residuals is significantly above 1 (their sum beyond χ²(n)'s 99 % quantile), R claims
+//! too little and is multiplied by it as well. Both together at most
+//! `gnss.error_correlation_max_inflation`.
+//! Choice (the mean): not removed; a constant bias is the extreme of correlation.
+//! Choice (the gate): the gate keeps the variance without the inflation, since a correlated
+//! error's size at one epoch is its marginal σ; only its averaging is wrong.
+//! Choice (the window): [`WINDOW_EPOCHS`]; the inflation is decided from the epochs before
+//! (the fix judge's rule), and a channel whose epochs are more than
+//! `adaptive.max_epoch_gap_s` apart starts afresh.
+//!
+//! Tried and not kept: the long-run variance ratio 1 + 2 Σ ρ̂ₖ over lags 1–8 in place of
+//! the AR(1) factor (a white part beside the multipath lowers ρ̂₁ more than the sum): on
+//! the default drive it left the foliage as it was and raised the mean NEES of every
+//! variant (e.g. the EKF 34.8 → 39.7).
+
+use std::collections::{BTreeMap, VecDeque};
+
+use crate::adaptive::common_mode::scaled_residuals;
+use crate::adaptive::mahalanobis::chi_square_quantile;
+use crate::gnss::SatId;
+
+use super::adaptive_noise::Observable;
+
+/// Epochs judged per channel. Choice: 20, over which a white error's ρ̂ has a σ of about
+/// 0.22, so that significance needs ρ̂ > 0.52; judged from 10 on.
+pub const WINDOW_EPOCHS: usize = 20;
+
+/// The standard normal 99 % quantile: the significance of ρ̂ > 0 under white errors,
+/// whose ρ̂ over n pairs has a standard deviation of about 1/√n.
+pub const Z_99: f64 = 2.326_347_874_040_841;
+
+/// One epoch's innovation of a channel, as the judge takes it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ChannelInnovation {
+    pub sat: SatId,
+    pub observable: Observable,
+    /// Innovation (any sign convention, the same for every epoch).
+    pub y: f64,
+    /// Its variance R before any inflation.
+    pub r: f64,
+    /// Coefficients of the errors common to every satellite of the observable: position
+    /// (or velocity) and clock (or clock drift) columns of the row.
+    pub common: [f64; 4],
+}
+
+/// The judge of every channel's error correlation.
+#[derive(Debug, Clone)]
+pub struct ErrorCorrelation {
+    /// Epochs judged per channel (0: off).
+    window: usize,
+    max_inflation: f64,
+    max_gap_s: f64,
+    channels: BTreeMap<(SatId, Observable), History>,
+}
+
+/// A channel's recent normalised parity residuals.
+#[derive(Debug, Clone, Default)]
+struct History {
+    /// (epoch time, residual / √R), oldest first; consecutive epochs only.
+    samples: VecDeque<(f64, f64)>,
+}
+
+impl ErrorCorrelation {
+    /// A judge (`on`, or one that inflates nothing) whose inflation is at most
+    /// `max_inflation`; epochs further apart than `max_gap_s` are not consecutive.
+    pub fn new(on: bool, max_inflation: f64, max_gap_s: f64) -> Self {
+        Self {
+            window: if on { WINDOW_EPOCHS } else { 0 },
+            max_inflation,
+            max_gap_s,
+            channels: BTreeMap::new(),
+        }
+    }
+
+    /// Forgets every channel (after a filter reset).
+    pub fn reset(&mut self) {
+        self.channels.clear();
+    }
+
+    /// The factor on the variance of `sat`'s `observable` at `t_s`, from the epochs
+    /// before (1 when off, unknown or not significantly correlated).
+    pub fn inflation(&self, sat: SatId, observable: Observable, t_s: f64) -> f64 {
+        if self.window == 0 {
+            return 1.0;
+        }
+        let Some(history) = self
+            .channels
+            .get(&(sat, observable))
+            .filter(|h| h.is_current(t_s, self.max_gap_s, self.window / 2))
+        else {
+            return 1.0;
+        };
+        let correlation = history.rho().map_or(1.0, |rho| (1.0 + rho) / (1.0 - rho));
+        (history.variance_ratio() * correlation).min(self.max_inflation)
+    }
+
+    /// Takes the innovations of one epoch at `t_s` (every channel of it, so that the
+    /// common errors can be fitted per observable).
+    pub fn push(&mut self, t_s: f64, epoch: &[ChannelInnovation]) {
+        if self.window == 0 {
+            return;
+        }
+        for observable in [Observable::Pseudorange, Observable::PseudorangeRate] {
+            let of: Vec<&ChannelInnovation> = epoch
+                .iter()
+                .filter(|c| c.observable == observable)
+                .collect();
+            let values: Vec<f64> = of.iter().map(|c| c.y).collect();
+            let geometry: Vec<[f64; 4]> = of.iter().map(|c| c.common).collect();
+            let weights: Vec<f64> = of.iter().map(|c| 1.0 / c.r).collect();
+            let Some(residuals) = scaled_residuals(&values, &geometry, &weights) else {
+                continue;
+            };
+            for (c, residual) in of.iter().zip(residuals) {
+                let Some(residual) = residual else { continue };
+                let history = self.channels.entry((c.sat, observable)).or_default();
+                history.push(t_s, residual / c.r.sqrt(), self.max_gap_s, self.window);
+            }
+        }
+        let max_gap_s = self.max_gap_s;
+        self.channels
+            .retain(|_, h| h.samples.back().is_some_and(|(t, _)| t_s - t <= max_gap_s));
+    }
+}
+
+impl History {
+    fn push(&mut self, t_s: f64, x: f64, max_gap_s: f64, window: usize) {
+        if !x.is_finite() {
+            return;
+        }
+        match self.samples.back() {
+            Some(&(t, _)) if t_s <= t => return,
+            Some(&(t, _)) if t_s - t > max_gap_s => self.samples.clear(),
+            _ => {}
+        }
+        self.samples.push_back((t_s, x));
+        while self.samples.len() > window + 1 {
+            self.samples.pop_front();
+        }
+    }
+
+    /// Whether the history holds at least `min_pairs` pairs (and two) and its last
+    /// sample is recent at `t_s`.
+    fn is_current(&self, t_s: f64, max_gap_s: f64, min_pairs: usize) -> bool {
+        self.samples
+            .back()
+            .is_some_and(|&(last, _)| t_s - last <= max_gap_s)
+            && self.samples.len() > min_pairs.max(2)
+    }
+
+    /// ρ̂ when it is significant (above [`Z_99`] / √pairs).
+    fn rho(&self) -> Option<f64> {
+        let pairs = self.samples.len().saturating_sub(1);
+        let (mut lagged, mut now, mut before) = (0.0, 0.0, 0.0);
+        for (a, b) in self.samples.iter().zip(self.samples.iter().skip(1)) {
+            lagged += a.1 * b.1;
+            now += b.1 * b.1;
+            before += a.1 * a.1;
+        }
+        let denominator = (now * before).sqrt();
+        if pairs == 0 || denominator <= 0.0 {
+            return None;
+        }
+        let rho = lagged / denominator;
+        (rho > Z_99 / (pairs as f64).sqrt()).then_some(rho.min(1.0 - 1e-9))
+    }
+
+    /// The mean square of the normalised residuals when it is significantly above 1 (the
+    /// sum beyond χ²(n)'s 99 % quantile), else 1: the variance R claims too little by.
+    fn variance_ratio(&self) -> f64 {
+        let n = self.samples.len();
+        let sum: f64 = self.samples.iter().map(|(_, x)| x * x).sum();
+        match chi_square_quantile(0.99, n) {
+            Ok(q) if sum > q => sum / n as f64,
+            _ => 1.0,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
+    use rand_distr::{Distribution, StandardNormal};
+
+    use super::*;
+    use crate::gnss::Constellation;
+
+    const SATELLITES: u16 = 10;
+
+    fn sat(prn: u16) -> SatId {
+        SatId {
+            constellation: Constellation::Gps,
+            prn,
+        }
+    }
+
+    /// A line of sight per satellite (spread over the sky) and a clock column.
+    fn common(prn: u16) -> [f64; 4] {
+        let azimuth = f64::from(prn) * 0.7;
+        let elevation = 0.2 + 0.12 * f64::from(prn);
+        let (se, ce) = elevation.sin_cos();
+        [ce * azimuth.sin(), ce * azimuth.cos(), se, 1.0]
+    }
+
+    /// Runs `epochs` epochs of range innovations of σ 1 m, `error(prn, rng)` each, and
+    /// returns the inflation of every satellite at the next epoch.
+    fn run(epochs: usize, mut error: impl FnMut(u16, &mut ChaCha8Rng) -> f64) -> Vec<f64> {
+        let mut judge = ErrorCorrelation::new(true, 25.0, 2.0);
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        for k in 0..epochs {
+            let epoch: Vec<ChannelInnovation> = (1..=SATELLITES)
+                .map(|prn| ChannelInnovation {
+                    sat: sat(prn),
+                    observable: Observable::Pseudorange,
+                    y: error(prn, &mut rng),
+                    r: 1.0,
+                    common: common(prn),
+                })
+                .collect();
+            judge.push(k as f64, &epoch);
+        }
+        (1..=SATELLITES)
+            .map(|prn| judge.inflation(sat(prn), Observable::Pseudorange, epochs as f64))
+            .collect()
+    }
+
+    fn white(rng: &mut ChaCha8Rng) -> f64 {
+        StandardNormal.sample(rng)
+    }
+
+    #[test]
+    fn white_errors_of_the_claimed_size_are_not_inflated() {
+        let inflations = run(60, |_, rng| white(rng));
+        let inflated = inflations.iter().filter(|&&f| f > 1.0).count();
+        assert!(inflated <= 1, "{inflations:?}");
+    }
+
+    #[test]
+    fn a_satellite_with_correlated_errors_is_inflated_alone() {
+        let mut multipath = 0.0;
+        let inflations = run(60, |prn, rng| {
+            if prn == 4 {
+                multipath = 0.95 * multipath + 0.3 * white(rng);
+                multipath + 0.3 * white(rng)
+            } else {
+                white(rng)
+            }
+        });
+        assert!(inflations[3] > 4.0, "{inflations:?}");
+        let others = inflations.iter().filter(|&&f| f > 1.0).count();
+        assert!(others <= 2, "{inflations:?}");
+    }
+
+    #[test]
+    fn an_error_every_satellite_shares_is_not_charged_to_them() {
+        // A slowly wandering state error (position and clock) seen through each line of
+        // sight: the filter's to estimate, not the satellites' errors.
+        let mut drift = [0.0; 4];
+        let inflations = run(60, |prn, rng| {
+            // Satellite 1 comes first in each epoch: the drift steps once per epoch.
+            if prn == 1 {
+                for d in &mut drift {
+                    *d = 0.98 * *d + 2.0 * white(rng);
+                }
+            }
+            let g = common(prn);
+            let shared: f64 = g.iter().zip(&drift).map(|(a, b)| a * b).sum();
+            shared + white(rng)
+        });
+        let inflated = inflations.iter().filter(|&&f| f > 1.0).count();
+        assert!(inflated <= 1, "{inflations:?}");
+    }
+
+    #[test]
+    fn errors_larger_than_claimed_are_inflated_by_their_mean_square() {
+        // Variance 9 times the claim; the mean square of 21 samples has a σ of about
+        // 9 · √(2/21) = 2.8 around it.
+        let inflations = run(60, |_, rng| 3.0 * white(rng));
+        for f in &inflations {
+            assert!((3.0..=25.0).contains(f), "{inflations:?}");
+        }
+        let median = {
+            let mut sorted = inflations.clone();
+            sorted.sort_by(f64::total_cmp);
+            sorted[sorted.len() / 2]
+        };
+        assert!((6.0..=13.0).contains(&median), "{inflations:?}");
+    }
+
+    #[test]
+    fn off_too_few_epochs_or_a_gap_inflate_nothing() {
+        let mut judge = ErrorCorrelation::new(false, 25.0, 2.0);
+        let biased = |k: usize| -> Vec<ChannelInnovation> {
+            (1..=SATELLITES)
+                .map(|prn| ChannelInnovation {
+                    sat: sat(prn),
+                    observable: Observable::Pseudorange,
+                    y: if prn == 2 {
+                        5.0
+                    } else {
+                        (-1f64).powi(k as i32 + i32::from(prn))
+                    },
+                    r: 1.0,
+                    common: common(prn),
+                })
+                .collect()
+        };
+        for k in 0..30 {
+            judge.push(k as f64, &biased(k));
+        }
+        assert_eq!(judge.inflation(sat(2), Observable::Pseudorange, 30.0), 1.0);
+        let mut judge = ErrorCorrelation::new(true, 25.0, 2.0);
+        for k in 0..5 {
+            judge.push(k as f64, &biased(k));
+        }
+        assert_eq!(judge.inflation(sat(2), Observable::Pseudorange, 5.0), 1.0);
+        for k in 5..30 {
+            judge.push(k as f64, &biased(k));
+        }
+        assert!(judge.inflation(sat(2), Observable::Pseudorange, 30.0) > 1.0);
+        assert_eq!(judge.inflation(sat(2), Observable::Pseudorange, 33.0), 1.0);
+        judge.push(33.0, &biased(33));
+        assert_eq!(judge.inflation(sat(2), Observable::Pseudorange, 34.0), 1.0);
+    }
+}
