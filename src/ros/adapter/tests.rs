@@ -933,6 +933,52 @@ fn carrier_phase_changes_used_and_left_out_are_counted_on_diagnostics() {
     assert_eq!(diagnostic(&adapter, "tdcp_phases_used"), None);
 }
 
+/// Issue 11, item 3: a satellite whose pseudo-range carries a constant 8 m bias (a
+/// facade's reflection) from 20 s on is judged correlated and its variance inflated,
+/// counted as `correlated_measurements` on /diagnostics; without `gnss.error_correlation`
+/// nothing is. (Not only that satellite: the fit of the common errors spreads its bias
+/// into the others' parity residuals, where it is constant too; measured 234 inflations
+/// over the 40 biased epochs.)
+#[test]
+fn correlated_errors_are_counted_on_diagnostics() {
+    use crate::sim::SimEvent;
+    let run = |judge: bool| {
+        let mut config = Config::default();
+        config
+            .set_parameter(
+                "gnss.error_correlation",
+                if judge { "true" } else { "false" },
+            )
+            .unwrap();
+        // At rest the heading is not observable: the static scenario's is given.
+        config.set_parameter("init.heading_deg", "0.0").unwrap();
+        let mut adapter = RosAdapter::new(config, OutputFrames::default());
+        for_each_static_event(60.0, |event, stamp| {
+            match event {
+                SimEvent::Imu(s) => adapter.on_imu(&outbound::imu(&s, stamp, "imu")),
+                SimEvent::Gnss { epoch, .. } => {
+                    let mut msg = outbound::gnss_measurements(&epoch, 0, stamp, "gnss");
+                    if epoch.t_s >= 20.0 {
+                        if let Some(reflected) = msg.satellites.first_mut() {
+                            reflected.pseudorange_m += 8.0;
+                        }
+                    }
+                    adapter.on_gnss(&msg)
+                }
+                _ => Vec::new(),
+            };
+        });
+        assert_eq!(adapter.engine().init_phase(), None, "running");
+        diagnostic(&adapter, "correlated_measurements")
+            .expect("a correlated_measurements key")
+            .parse::<u64>()
+            .unwrap()
+    };
+    let judged = run(true);
+    assert!(judged >= 30, "{judged} inflated");
+    assert_eq!(run(false), 0);
+}
+
 /// Issue 14, item 3: wheel odometry on /diagnostics. With `wheel_odometry.enabled`, the
 /// static scenario's standstill is reported by a base controller at the truth's rate:
 /// every message is counted as received; one with a NaN speed or a negative variance as
