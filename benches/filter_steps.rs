@@ -174,18 +174,21 @@ fn first_time_with_12(constellation: &GpsConstellation, p: &Llh) -> f64 {
 }
 
 /// The cost of one epoch in steady state (windows full, M = 100) for the plain EKF and the
-/// adaptive variants: the difference is the adaptive step's added cost.
+/// adaptive variants: the difference is the adaptive step's added cost; and the EKF
+/// without the error-correlation judge (`gnss.error_correlation`): the judge's cost.
 fn tc_update_adaptive(c: &mut Criterion) {
     let p = Llh::from_degrees(39.1, 117.2, 20.0);
     let epochs = noisy_epochs(&p, 2000);
     let w = Vector3::zeros();
-    for variant in [
-        FilterVariant::Ekf,
-        FilterVariant::Srmakf,
-        FilterVariant::Ermakf,
+    for (variant, judged) in [
+        (FilterVariant::Ekf, true),
+        (FilterVariant::Ekf, false),
+        (FilterVariant::Srmakf, true),
+        (FilterVariant::Ermakf, true),
     ] {
         let mut config = Config::default();
         config.filter.variant = variant;
+        config.gnss.error_correlation = judged;
         config.gnss.elevation_mask_rad = 5f64.to_radians();
         let mut state = running_state(p);
         let mut adaptation = Adaptation::new(&config);
@@ -195,7 +198,12 @@ fn tc_update_adaptive(c: &mut Criterion) {
             update::apply(&mut state, &mut model, &mut adaptation, true).expect("update");
         }
         let mut k = 150usize;
-        let name = format!("tc_epoch_12_satellites_{}", variant.as_str());
+        let unjudged = if judged {
+            ""
+        } else {
+            "_without_error_correlation"
+        };
+        let name = format!("tc_epoch_12_satellites_{}{unjudged}", variant.as_str());
         c.bench_function(&name, |b| {
             b.iter(|| {
                 let laps = (k / epochs.len()) as f64;

@@ -79,6 +79,9 @@ pub struct ErrorCorrelation {
     window: usize,
     max_inflation: f64,
     max_gap_s: f64,
+    /// χ²(n)'s 99 % quantile for n = 0..=window + 1 (NaN for 0): the variance test's,
+    /// computed once (the quantile is an iterative inversion).
+    chi2_99: Vec<f64>,
     channels: BTreeMap<(SatId, Observable), History>,
 }
 
@@ -93,10 +96,15 @@ impl ErrorCorrelation {
     /// A judge (`on`, or one that inflates nothing) whose inflation is at most
     /// `max_inflation`; epochs further apart than `max_gap_s` are not consecutive.
     pub fn new(on: bool, max_inflation: f64, max_gap_s: f64) -> Self {
+        let window = if on { WINDOW_EPOCHS } else { 0 };
+        let chi2_99 = (0..=window + 1)
+            .map(|n| chi_square_quantile(0.99, n).unwrap_or(f64::NAN))
+            .collect();
         Self {
-            window: if on { WINDOW_EPOCHS } else { 0 },
+            window,
             max_inflation,
             max_gap_s,
+            chi2_99,
             channels: BTreeMap::new(),
         }
     }
@@ -120,7 +128,7 @@ impl ErrorCorrelation {
             return 1.0;
         };
         let correlation = history.rho().map_or(1.0, |rho| (1.0 + rho) / (1.0 - rho));
-        (history.variance_ratio() * correlation).min(self.max_inflation)
+        (history.variance_ratio(&self.chi2_99) * correlation).min(self.max_inflation)
     }
 
     /// Takes the innovations of one epoch at `t_s` (every channel of it, so that the
@@ -196,13 +204,13 @@ impl History {
 
     /// The mean square of the normalised residuals, or of the last [`RECENT_EPOCHS`] when
     /// larger, when the window's is significantly above 1 (its sum beyond χ²(n)'s 99 %
-    /// quantile), else 1: the variance R claims too little by.
-    fn variance_ratio(&self) -> f64 {
+    /// quantile, `chi2_99[n]`), else 1: the variance R claims too little by.
+    fn variance_ratio(&self, chi2_99: &[f64]) -> f64 {
         let n = self.samples.len();
         let square = |(_, x): &(f64, f64)| x * x;
         let sum: f64 = self.samples.iter().map(square).sum();
-        match chi_square_quantile(0.99, n) {
-            Ok(q) if sum > q => {
+        match chi2_99.get(n) {
+            Some(&q) if sum > q => {
                 let k = n.min(RECENT_EPOCHS);
                 let recent: f64 = self.samples.iter().rev().take(k).map(square).sum();
                 (sum / n as f64).max(recent / k as f64)
