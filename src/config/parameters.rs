@@ -349,7 +349,8 @@ parameter_table! {
         /// Judge each satellite's pseudo-range and rate errors over its last 20 epochs by
         /// the filter's innovations (their part that no error common to all satellites
         /// explains): where their lag-one autocorrelation ρ is significant, multiply the
-        /// variance by (1 + ρ)/(1 − ρ), and where their mean square is, by that too. A
+        /// variance by (1 + ρ)/(1 − ρ), and where their mean square is significantly above
+        /// 1, by it too (or by the last 6 epochs' when larger). A
         /// filter that takes correlated errors (multipath under foliage, a facade's
         /// reflection) for independent ones claims a precision it does not have. Counted
         /// (correlated_measurements). false = the variances as the variant gives them

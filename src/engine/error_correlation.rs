@@ -115,7 +115,8 @@ impl ErrorCorrelation {
     }
 
     /// The factor on the variance of `sat`'s `observable` at `t_s`, from the epochs
-    /// before (1 when off, unknown or not significantly correlated).
+    /// before (1 when off, unknown, or neither significantly correlated nor larger than
+    /// claimed).
     pub fn inflation(&self, sat: SatId, observable: Observable, t_s: f64) -> f64 {
         if self.window == 0 {
             return 1.0;
