@@ -109,6 +109,11 @@ impl ErrorCorrelation {
         }
     }
 
+    /// Whether the judge is on (`gnss.error_correlation`).
+    pub fn is_on(&self) -> bool {
+        self.window > 0
+    }
+
     /// Forgets every channel (after a filter reset).
     pub fn reset(&mut self) {
         self.channels.clear();
@@ -118,7 +123,7 @@ impl ErrorCorrelation {
     /// before (1 when off, unknown, or neither significantly correlated nor larger than
     /// claimed).
     pub fn inflation(&self, sat: SatId, observable: Observable, t_s: f64) -> f64 {
-        if self.window == 0 {
+        if !self.is_on() {
             return 1.0;
         }
         let Some(history) = self
@@ -135,7 +140,7 @@ impl ErrorCorrelation {
     /// Takes the innovations of one epoch at `t_s` (every channel of it, so that the
     /// common errors can be fitted per observable).
     pub fn push(&mut self, t_s: f64, epoch: &[ChannelInnovation]) {
-        if self.window == 0 {
+        if !self.is_on() {
             return;
         }
         for observable in [Observable::Pseudorange, Observable::PseudorangeRate] {

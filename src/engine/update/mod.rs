@@ -245,6 +245,9 @@ impl<M: MeasurementModel> Step<'_, M> {
     ) -> Vec<f64> {
         let t_s = self.model.t_s();
         let judge = &mut self.adaptation.correlation;
+        if !judge.is_on() {
+            return vec![1.0; channels.len()];
+        }
         let factors = channels
             .iter()
             .map(|c| judge.inflation(c.sat, c.observable, t_s))
