@@ -67,6 +67,47 @@ pub fn scaled_residuals<const P: usize>(
     )
 }
 
+/// The median of χ²(1): that of a squared scaled residual of the claimed variance.
+pub const CHI2_1_MEDIAN: f64 = 0.454_936_423_119_572_8;
+
+/// The asymptotic standard deviation of the median of n χ²(1) values over
+/// [`CHI2_1_MEDIAN`], times √n: 1 / (2 f(m) m), with f the χ²(1) density at its median m.
+pub const MEDIAN_RATIO_SD: f64 = 2.332_774_574_888_844;
+
+/// The median of `values` (sorted in place); None when empty.
+pub fn median(values: &mut [f64]) -> Option<f64> {
+    if values.is_empty() {
+        return None;
+    }
+    values.sort_by(f64::total_cmp);
+    let n = values.len();
+    Some(if n % 2 == 1 {
+        values[n / 2]
+    } else {
+        0.5 * (values[n / 2 - 1] + values[n / 2])
+    })
+}
+
+/// The factor by which the variances claimed for `squares` (squared scaled residuals
+/// divided by their claimed variance, sorted in place) are too small, estimated robustly as
+/// their median over [`CHI2_1_MEDIAN`]: Some only when it exceeds 1 by more than `z` of its
+/// standard deviations (a one-sided test; `z` 2.33 for 99 %) with `independent` values
+/// behind them, at least `min_independent`. The residuals of one fit are correlated: n of
+/// them after fitting P parameters hold about n − P independent ones, which the caller
+/// says. A minority of outliers moves the median little, where it would dominate the mean.
+pub fn robust_variance_ratio(
+    squares: &mut [f64],
+    independent: f64,
+    min_independent: f64,
+    z: f64,
+) -> Option<f64> {
+    if independent < min_independent.max(1.0) {
+        return None;
+    }
+    let ratio = median(squares)? / CHI2_1_MEDIAN;
+    (ratio > 1.0 + z * MEDIAN_RATIO_SD / independent.sqrt()).then_some(ratio)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -146,5 +187,35 @@ mod tests {
         assert!(scaled_residuals(&[f64::NAN; 7], &g, &[1.0; 7]).is_none());
         let same = vec![[1.0, 0.0, 0.0, 1.0]; 7];
         assert!(scaled_residuals(&[0.0; 7], &same, &[1.0; 7]).is_none());
+    }
+
+    #[test]
+    fn the_robust_variance_ratio_finds_the_scale_of_the_majority() {
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let mut draw = |n: usize, variance: f64| -> Vec<f64> {
+            (0..n)
+                .map(|_| {
+                    let x: f64 = StandardNormal.sample(&mut rng);
+                    variance * x * x
+                })
+                .collect()
+        };
+        // Of the claimed variance: not significant (at 99 %) in nearly every trial.
+        let significant = (0..200)
+            .filter(|_| robust_variance_ratio(&mut draw(30, 1.0), 30.0, 8.0, 2.326).is_some())
+            .count();
+        assert!(significant <= 8, "{significant} of 200");
+        // Four times the claim, a tenth of the values a hundred times it: the median
+        // moves to the majority's 0.5/0.9 quantile, a ratio of 5.1, where the mean's
+        // would be 13.6.
+        let mut mixed = draw(450, 4.0);
+        mixed.extend(draw(50, 100.0));
+        let ratio = robust_variance_ratio(&mut mixed, 500.0, 8.0, 2.326).unwrap();
+        assert!((4.0..6.0).contains(&ratio), "{ratio}");
+        // Too few values: no verdict.
+        assert_eq!(
+            robust_variance_ratio(&mut draw(7, 50.0), 7.0, 8.0, 2.326),
+            None
+        );
     }
 }

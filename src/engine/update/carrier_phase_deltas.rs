@@ -49,9 +49,9 @@ use crate::ins::error_state::{DV, N};
 use super::super::filter_state::FilterState;
 use super::super::output::{EpochReport, MeasurementKind, PhaseRejection, SatRejection, SatReport};
 use super::super::phase_anchor::{AnchoredPhase, PhaseAnchor};
-use super::gate::median;
 use super::model::{Linearization, MeasurementModel, NominalNoise};
 use super::pseudoranges::{screen, sigma_model};
+use crate::adaptive::common_mode::median;
 
 /// Fewest phase changes an update uses.
 ///

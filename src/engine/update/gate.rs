@@ -1,5 +1,6 @@
 //! The innovation gate of scalar measurements.
 
+use crate::adaptive::common_mode::median;
 use crate::filter::measurement_rows::{row_variance, Row};
 use crate::ins::error_state::StateMatrix;
 
@@ -65,18 +66,4 @@ pub(super) fn gate(
         }
     }
     kept
-}
-
-/// The median of `values` (sorted in place); None when empty.
-pub(super) fn median(values: &mut [f64]) -> Option<f64> {
-    if values.is_empty() {
-        return None;
-    }
-    values.sort_by(f64::total_cmp);
-    let n = values.len();
-    Some(if n % 2 == 1 {
-        values[n / 2]
-    } else {
-        0.5 * (values[n / 2 - 1] + values[n / 2])
-    })
 }

@@ -14,8 +14,8 @@ use crate::gnss::{GnssEpoch, SatObservation};
 use super::super::adaptive_noise::{NoiseVerdict, Observable};
 use super::super::filter_state::FilterState;
 use super::super::output::{EpochReport, MeasurementKind, SatRejection, SatReport};
-use super::gate::median;
 use super::model::{Linearization, MeasurementModel, NoiseChannel, NominalNoise};
+use crate::adaptive::common_mode::median;
 
 /// The measurement σ model of the configuration.
 pub fn sigma_model(config: &Config) -> SigmaModel {
