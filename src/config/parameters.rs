@@ -350,7 +350,9 @@ parameter_table! {
         /// the filter's innovations (their part that no error common to all satellites
         /// explains): where their lag-one autocorrelation ρ is significant, multiply the
         /// variance by (1 + ρ)/(1 − ρ), and where their mean square is significantly above
-        /// 1, by it too (or by the last 6 epochs' when larger). A
+        /// 1, by it too (or by the last 6 epochs' when larger); and every satellite's by at
+        /// least the observable's common scale when the median over the last 3 epochs'
+        /// satellites is significantly above 1 (entering foliage). A
         /// filter that takes correlated errors (multipath under foliage, a facade's
         /// reflection) for independent ones claims a precision it does not have. Counted
         /// (correlated_measurements). false = the variances as the variant gives them
