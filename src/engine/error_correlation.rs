@@ -135,10 +135,13 @@ struct Pooled {
 }
 
 /// A channel's recent normalised parity residuals.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone)]
 struct History {
     /// (epoch time, residual / √R), oldest first; consecutive epochs only.
     samples: VecDeque<(f64, f64)>,
+    /// The own tests' factors on these samples, (variance, correlation), each 1 when not
+    /// significant: judged once per epoch, when a sample comes.
+    factors: (f64, f64),
 }
 
 impl ErrorCorrelation {
@@ -193,9 +196,8 @@ impl ErrorCorrelation {
         else {
             return common.min(self.max_inflation);
         };
-        let correlation = history.rho().map_or(1.0, |rho| (1.0 + rho) / (1.0 - rho));
-        let variance = history.variance_ratio(&self.chi2_99).max(common);
-        (variance * correlation).min(self.max_inflation)
+        let (variance, correlation) = history.factors;
+        (variance.max(common) * correlation).min(self.max_inflation)
     }
 
     /// Takes the innovations of one epoch at `t_s` (every channel of it, so that the
@@ -220,12 +222,10 @@ impl ErrorCorrelation {
                 let Some(residual) = residual else { continue };
                 let x = residual / c.r.sqrt();
                 let history = self.channels.entry((c.sat, observable)).or_default();
-                if !history.is_singled_out(t_s, self.max_gap_s, self.window / 2, &self.chi2_99)
-                    && x.is_finite()
-                {
+                if !history.is_singled_out(t_s, self.max_gap_s, self.window / 2) && x.is_finite() {
                     squares.push(x * x);
                 }
-                history.push(t_s, x, self.max_gap_s, self.window);
+                history.push(t_s, x, self.max_gap_s, self.window, &self.chi2_99);
             }
             // Of n residuals after the fit, about n − 4 are independent.
             let independent =
@@ -262,8 +262,19 @@ impl Pooled {
     }
 }
 
+impl Default for History {
+    fn default() -> Self {
+        Self {
+            samples: VecDeque::new(),
+            factors: (1.0, 1.0),
+        }
+    }
+}
+
 impl History {
-    fn push(&mut self, t_s: f64, x: f64, max_gap_s: f64, window: usize) {
+    /// Takes the sample `x` of `t_s` and judges the window (`chi2_99`: χ²(n)'s 99 %
+    /// quantiles by n).
+    fn push(&mut self, t_s: f64, x: f64, max_gap_s: f64, window: usize, chi2_99: &[f64]) {
         if !x.is_finite() {
             return;
         }
@@ -276,6 +287,8 @@ impl History {
         while self.samples.len() > window + 1 {
             self.samples.pop_front();
         }
+        let correlation = self.rho().map_or(1.0, |rho| (1.0 + rho) / (1.0 - rho));
+        self.factors = (self.variance_ratio(chi2_99), correlation);
     }
 
     /// Whether the history holds at least `min_pairs` pairs (and two) and its last
@@ -289,9 +302,8 @@ impl History {
 
     /// Whether the channel's own tests find it correlated or larger than claimed (on the
     /// epochs before `t_s`).
-    fn is_singled_out(&self, t_s: f64, max_gap_s: f64, min_pairs: usize, chi2_99: &[f64]) -> bool {
-        self.is_current(t_s, max_gap_s, min_pairs)
-            && (self.rho().is_some() || self.variance_ratio(chi2_99) > 1.0)
+    fn is_singled_out(&self, t_s: f64, max_gap_s: f64, min_pairs: usize) -> bool {
+        self.is_current(t_s, max_gap_s, min_pairs) && (self.factors.0 > 1.0 || self.factors.1 > 1.0)
     }
 
     /// ρ̂ when it is significant (above [`Z_99`] / √pairs).
