@@ -39,6 +39,7 @@
 
 use nalgebra::{DMatrix, DVector, SMatrix, Vector3};
 
+use crate::adaptive::common_mode::median;
 use crate::config::Config;
 use crate::filter::measurement_rows::{row_variance, AntennaGeometry, Row};
 use crate::filter::process_model::{self, LinearizationPoint, ProcessNoise};
@@ -51,7 +52,6 @@ use super::super::output::{EpochReport, MeasurementKind, PhaseRejection, SatReje
 use super::super::phase_anchor::{AnchoredPhase, PhaseAnchor};
 use super::model::{Linearization, MeasurementModel, NominalNoise};
 use super::pseudoranges::{screen, sigma_model};
-use crate::adaptive::common_mode::median;
 
 /// Fewest phase changes an update uses.
 ///

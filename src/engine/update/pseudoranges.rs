@@ -4,6 +4,7 @@
 
 use nalgebra::{DVector, Vector3};
 
+use crate::adaptive::common_mode::median;
 use crate::config::Config;
 use crate::filter::measurement_rows::AntennaGeometry;
 use crate::filter::robust_update::UpdateOutcome;
@@ -15,7 +16,6 @@ use super::super::adaptive_noise::{NoiseVerdict, Observable};
 use super::super::filter_state::FilterState;
 use super::super::output::{EpochReport, MeasurementKind, SatRejection, SatReport};
 use super::model::{Linearization, MeasurementModel, NoiseChannel, NominalNoise};
-use crate::adaptive::common_mode::median;
 
 /// The measurement σ model of the configuration.
 pub fn sigma_model(config: &Config) -> SigmaModel {
