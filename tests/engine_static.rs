@@ -8,6 +8,8 @@ use adaptive_gnss_ins::engine::{
     Engine, Output, RejectionReason, ResetReason, SatRejection, StatusEvent,
 };
 use adaptive_gnss_ins::gnss::GnssEpoch;
+use adaptive_gnss_ins::ins::error_state::ACC_BIAS;
+use nalgebra::{UnitQuaternion, Vector3};
 use support::{static_config, StaticScenario};
 
 /// Position error budget of a static receiver after a minute of 1 Hz GNSS with 3 m zenith
@@ -423,4 +425,55 @@ fn start_combines_the_single_point_solutions_before_it() {
             assert!(nees < CHI2_3DOF_999, "seed {seed}: start NEES {nees}");
         }
     }
+}
+
+/// A levelling at rest measures the accelerometer bias along gravity (the magnitude of
+/// the mean specific force less the normal gravity) and starts the filter with it; the
+/// bias across gravity, which tilts the levelling instead, keeps the class's σ.
+#[test]
+fn the_levelling_at_rest_measures_the_accelerometer_bias_along_gravity() {
+    let micro_g_m_s2 = 9.806_65e-6;
+    let mut run = Run::new(3);
+    run.scenario.q_nb = UnitQuaternion::from_euler_angles(0.05, -0.03, 0.7);
+    let bias_m_s2 = Vector3::new(800.0, -600.0, 2000.0) * micro_g_m_s2;
+    let dt = 1.0 / run.scenario.imu_rate_hz;
+    let mut started_at = None;
+    for k in 0..300 {
+        let t = k as f64 * dt;
+        let mut sample = run.scenario.imu(t);
+        sample.f_ib_b_m_s2 += bias_m_s2;
+        run.outputs.extend(run.engine.push_imu(&sample).unwrap());
+        if (t - t.round()).abs() < 1e-9 {
+            let epoch = run.scenario.gnss(t);
+            run.outputs.extend(run.engine.push_gnss(epoch).unwrap());
+        }
+        if started_at.is_none() && run.engine.state().is_some() {
+            started_at = Some(t);
+            break;
+        }
+    }
+    assert!(started_at.is_some(), "the filter did not start within 3 s");
+    let s = run.engine.state().unwrap();
+    let up_b = (run.scenario.q_nb.inverse() * Vector3::z()).normalize();
+    let p = s.p.fixed_view::<3, 3>(ACC_BIAS, ACC_BIAS).into_owned();
+    let sigma_up_m_s2 = (up_b.dot(&(p * up_b))).sqrt();
+    let error_up_m_s2 = up_b.dot(&(s.accel_bias_m_s2 - bias_m_s2));
+    assert!(
+        sigma_up_m_s2 < 250.0 * micro_g_m_s2,
+        "σ along gravity {:.0} µg",
+        sigma_up_m_s2 / micro_g_m_s2
+    );
+    assert!(
+        error_up_m_s2.abs() < 3.0 * sigma_up_m_s2,
+        "error along gravity {:.0} µg at a σ of {:.0} µg",
+        error_up_m_s2 / micro_g_m_s2,
+        sigma_up_m_s2 / micro_g_m_s2
+    );
+    let across_b = up_b.cross(&Vector3::x()).normalize();
+    let sigma_across_m_s2 = (across_b.dot(&(p * across_b))).sqrt();
+    assert!(
+        sigma_across_m_s2 > 1200.0 * micro_g_m_s2,
+        "σ across gravity {:.0} µg: the levelling cannot see it",
+        sigma_across_m_s2 / micro_g_m_s2
+    );
 }

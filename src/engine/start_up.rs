@@ -63,7 +63,7 @@ impl Engine {
             nav: initial.nav,
             gyro_bias_rad_s: initial.gyro_bias_rad_s,
             gyro_markov_rad_s: Vector3::zeros(),
-            accel_bias_m_s2: Vector3::zeros(),
+            accel_bias_m_s2: initial.accel_bias_m_s2,
             clock_bias_m: initial.clock_bias_m,
             clock_drift_mps: initial.clock_drift_mps,
             wheel_scale_factor: self.config.wheel_odometry.scale_factor,

@@ -1,8 +1,10 @@
 //! Start-up with no hand-entered state.
 //!
 //! 1. Levelling: roll and pitch from the mean specific force over
-//!    `init.leveling_duration_s`, and the gyro bias from the mean angular rate less the
-//!    earth rate (resolved once the position and heading are known) — only when the
+//!    `init.leveling_duration_s`, the gyro bias from the mean angular rate less the
+//!    earth rate (resolved once the position and heading are known), and the
+//!    accelerometer bias along gravity from the mean specific force's magnitude less the
+//!    normal gravity at the start's position ([`initial_state`]) — only when the
 //!    window is at rest: the standstill test of [`super::standstill`] over the window, and
 //!    no GNSS speed (when one is known) that denies it ([`REST_SPEED_MAX_MPS`]). A moving
 //!    window gives no attitude and no gyro bias (a turn's rate is no bias); the next window
@@ -95,6 +97,7 @@ fn significant(x: &Vector2<f64>, cov: &Matrix2<f64>) -> bool {
 pub struct InitialState {
     pub nav: NavState,
     pub gyro_bias_rad_s: Vector3<f64>,
+    pub accel_bias_m_s2: Vector3<f64>,
     pub clock_bias_m: f64,
     pub clock_drift_mps: f64,
     pub p: StateMatrix,
@@ -197,7 +200,12 @@ struct Rest {
     q_level: UnitQuaternion<f64>,
     /// The mean angular rate over the window (earth rate included).
     mean_w_rad_s: Vector3<f64>,
+    /// The mean specific force over the window: gravity's reaction plus the
+    /// accelerometer bias.
+    mean_f_m_s2: Vector3<f64>,
     window_s: f64,
+    /// End of the window (s).
+    t_end_s: f64,
 }
 
 /// The start-up state machine.
@@ -371,7 +379,9 @@ impl Initializer {
                 at_rest: Some(Rest {
                     q_level: q_nb,
                     mean_w_rad_s: w,
+                    mean_f_m_s2: f,
                     window_s,
+                    t_end_s: s.t_s,
                 }),
             });
         }
