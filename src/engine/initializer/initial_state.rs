@@ -31,15 +31,14 @@ const NORMAL_GRAVITY_SIGMA_M_S2: f64 = 1.0e-3;
 /// P = σ_p² I − σ_p⁴ u uᵀ / (σ_p² + σ_m²). Its σ_m² holds the velocity random walk's mean
 /// over the window, the bias's Gauss–Markov drift from the window to the start at `t_s`
 /// (which the filter's propagation, from the start on, does not see), the gravity model's
-/// error
-/// ([`NORMAL_GRAVITY_SIGMA_M_S2`]) and, when the scale factors are states of their own,
-/// the scale factor's share of the magnitude (without them the bias state takes that
+/// error ([`NORMAL_GRAVITY_SIGMA_M_S2`]) and, when the scale factors are states of their
+/// own, the scale factor's share of the magnitude (without them the bias state takes that
 /// share, as it does in motion, where the vertical specific force stays near γ).
 ///
 /// Choice: without it the filter started with the class's σ on the vertical bias (1250 µg
 /// for the defaults' tactical grade) and then learnt it from the GNSS while moving. On
-/// the default drive the rates' correlated errors in the foliage moved it by 1700 µg (3σ)
-/// within 20 s and the height by 16 m at a σ of 2.6 m.
+/// the default drive the rates' correlated errors in the foliage moved it 1740 µg off (3σ)
+/// within 20 s, and the height 16 m at a σ of 2.6 m (docs/results.md).
 fn accel_bias_along_gravity(
     rest: &Rest,
     t_s: f64,
