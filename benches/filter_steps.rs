@@ -148,6 +148,11 @@ fn noisy_epochs(p: &Llh, count: usize) -> Vec<GnssEpoch> {
                 .simulate_epoch(t, &rx, &atmosphere, 5f64.to_radians(), &mut noise)
                 .expect("simulated epoch");
             e.satellites.truncate(12);
+            // Reported as a receiver does (u-blox `cno`), so that the judge's C/N0
+            // deficit is weighed too (steady, no deficit).
+            for s in &mut e.satellites {
+                s.cn0_dbhz = Some(45.0);
+            }
             e
         })
         .collect()

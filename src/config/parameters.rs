@@ -352,7 +352,9 @@ parameter_table! {
         /// variance by (1 + ρ)/(1 − ρ), and where their mean square is significantly above
         /// 1, by it too (or by the last 6 epochs' when larger); and every satellite's by at
         /// least the observable's common scale when the median over the last 3 epochs'
-        /// satellites is significantly above 1 (entering foliage). A
+        /// satellites is significantly above 1 (entering foliage); and, from the epoch it
+        /// is seen, a satellite's by at least 10^(2 (Δ − 3 dB) / 10) when its C/N0 is Δ
+        /// below its own recent level (SIGMA-Δ weighting of an obstructed signal). A
         /// filter that takes correlated errors (multipath under foliage, a facade's
         /// reflection) for independent ones claims a precision it does not have. Counted
         /// (correlated_measurements). false = the variances as the variant gives them

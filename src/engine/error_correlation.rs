@@ -41,6 +41,10 @@
 //! chosen over 99 % (2.7 % of quiet epochs), which reacts later: the default drive's EKF
 //! had 5.61 m and a mean NEES of 20.6 with it, against 5.55 m and 19.3 (seed 3: 3.62 m
 //! and 13.3 against 3.47 m and 10.9).
+//! Choice (the C/N0 deficit): a satellite whose C/N0 falls below its own recent level is
+//! floored at once by [`Cn0Deficit`] (SIGMA-Δ), epochs before the residuals can show it:
+//! the default drive's foliage needed an inflation of its size from its first epoch
+//! (docs/results.md, the oracle).
 //! Choice (the mean): not removed; a constant bias is the extreme of correlation.
 //! Choice (the gate): the gate keeps the variance without the inflation, since a correlated
 //! error's size at one epoch is its marginal σ; only its averaging is wrong.
@@ -65,6 +69,7 @@ use crate::adaptive::mahalanobis::chi_square_quantile;
 use crate::gnss::SatId;
 
 use super::adaptive_noise::Observable;
+use super::cn0_deficit::Cn0Deficit;
 
 /// Epochs judged per channel. Choice: 20, over which a white error's ρ̂ has a σ of about
 /// 0.22, so that significance needs ρ̂ > 0.52; judged from 10 on.
@@ -103,6 +108,8 @@ pub struct ChannelInnovation {
     pub y: f64,
     /// Its variance R before any inflation.
     pub r: f64,
+    /// The satellite's C/N0 (dB-Hz), when reported.
+    pub cn0_dbhz: Option<f64>,
     /// Coefficients of the errors common to every satellite of the observable: position
     /// (or velocity) and clock (or clock drift) columns of the row.
     pub common: [f64; COMMON_COLUMNS],
@@ -122,6 +129,8 @@ pub struct ErrorCorrelation {
     /// Per observable, the squared normalised residuals of the last [`POOLED_EPOCHS`]
     /// epochs' channels that were not singled out, and the common scale they give.
     pooled: BTreeMap<Observable, Pooled>,
+    /// The satellites' C/N0 references, whose deficit floors the inflation.
+    cn0: Cn0Deficit,
 }
 
 /// An observable's pooled residuals (see the module's choices).
@@ -159,6 +168,7 @@ impl ErrorCorrelation {
             chi2_99,
             channels: BTreeMap::new(),
             pooled: BTreeMap::new(),
+            cn0: Cn0Deficit::default(),
         }
     }
 
@@ -171,6 +181,7 @@ impl ErrorCorrelation {
     pub fn reset(&mut self) {
         self.channels.clear();
         self.pooled.clear();
+        self.cn0.clear();
     }
 
     /// The factor on the variance of `sat`'s `observable` at `t_s`, from the epochs
@@ -200,11 +211,25 @@ impl ErrorCorrelation {
         (variance.max(common) * correlation).min(self.max_inflation)
     }
 
+    /// The floor of `sat`'s inflation at `t_s` from its C/N0 of that epoch,
+    /// `cn0_dbhz`, against its reference from the epochs before ([`Cn0Deficit`]; 1 when
+    /// off).
+    pub fn cn0_floor(&self, sat: SatId, t_s: f64, cn0_dbhz: Option<f64>) -> f64 {
+        if !self.is_on() {
+            return 1.0;
+        }
+        self.cn0
+            .floor(sat, t_s, cn0_dbhz, self.max_gap_s, self.max_inflation)
+    }
+
     /// Takes the innovations of one epoch at `t_s` (every channel of it, so that the
     /// common errors can be fitted per observable).
     pub fn push(&mut self, t_s: f64, epoch: &[ChannelInnovation]) {
         if !self.is_on() {
             return;
+        }
+        for c in epoch {
+            self.cn0.push(c.sat, t_s, c.cn0_dbhz, self.max_gap_s);
         }
         for observable in [Observable::Pseudorange, Observable::PseudorangeRate] {
             let of: Vec<&ChannelInnovation> = epoch
@@ -240,6 +265,7 @@ impl ErrorCorrelation {
         let max_gap_s = self.max_gap_s;
         self.channels
             .retain(|_, h| h.samples.back().is_some_and(|(t, _)| t_s - t <= max_gap_s));
+        self.cn0.forget_older_than(t_s, max_gap_s);
     }
 }
 
@@ -379,6 +405,7 @@ mod tests {
                     observable: Observable::Pseudorange,
                     y: error(prn, &mut rng),
                     r: 1.0,
+                    cn0_dbhz: None,
                     common: common(prn),
                 })
                 .collect();
@@ -466,6 +493,7 @@ mod tests {
                         (-1f64).powi(k as i32 + i32::from(prn))
                     },
                     r: 1.0,
+                    cn0_dbhz: None,
                     common: common(prn),
                 })
                 .collect()
@@ -514,6 +542,7 @@ mod tests {
                         observable: Observable::Pseudorange,
                         y: sigma * white(&mut rng),
                         r: 1.0,
+                        cn0_dbhz: None,
                         common: common(prn),
                     })
                     .collect();
@@ -552,6 +581,7 @@ mod tests {
                     observable: Observable::Pseudorange,
                     y: white(&mut rng),
                     r: 1.0,
+                    cn0_dbhz: None,
                     common: common(prn),
                 })
                 .collect();

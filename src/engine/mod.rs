@@ -52,6 +52,7 @@
 
 mod adaptation;
 pub mod adaptive_noise;
+mod cn0_deficit;
 mod constraints;
 pub mod divergence;
 mod dual_antenna;

@@ -250,7 +250,11 @@ impl<M: MeasurementModel> Step<'_, M> {
         }
         let factors = channels
             .iter()
-            .map(|c| judge.inflation(c.sat, c.observable, t_s))
+            .map(|c| {
+                judge
+                    .inflation(c.sat, c.observable, t_s)
+                    .max(judge.cn0_floor(c.sat, t_s, c.cn0_dbhz))
+            })
             .collect();
         if self.learn {
             let epoch: Vec<ChannelInnovation> = channels
@@ -267,6 +271,7 @@ impl<M: MeasurementModel> Step<'_, M> {
                         observable: c.observable,
                         y: y[i],
                         r: r[i],
+                        cn0_dbhz: c.cn0_dbhz,
                         common: [row[first], row[first + 1], row[first + 2], row[clock]],
                     }
                 })

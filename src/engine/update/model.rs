@@ -102,4 +102,6 @@ pub struct NoiseChannel {
     /// The variance of the slow error part added to an estimated variance
     /// (`adaptive.pseudorange_slow_sigma_m`; 0 for rates).
     pub r_slow: f64,
+    /// The satellite's carrier-to-noise density ratio (dB-Hz), when reported.
+    pub cn0_dbhz: Option<f64>,
 }

@@ -137,6 +137,7 @@ impl MeasurementModel for Pseudoranges<'_> {
                             observable,
                             r_nominal: sigma.powi(2),
                             r_slow: slow.powi(2),
+                            cn0_dbhz: obs.cn0_dbhz,
                         });
                         self.sources.push(RowSource {
                             sat_index,
