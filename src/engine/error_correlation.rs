@@ -185,12 +185,28 @@ impl ErrorCorrelation {
     }
 
     /// The factor on the variance of `sat`'s `observable` at `t_s`, from the epochs
-    /// before (1 when off, or when neither the channel is significantly correlated or
-    /// larger than claimed nor its observable's common scale is).
-    pub fn inflation(&self, sat: SatId, observable: Observable, t_s: f64) -> f64 {
+    /// before, and at least the floor of the satellite's C/N0 of this epoch, `cn0_dbhz`
+    /// ([`Cn0Deficit`]); 1 when off, or when neither the channel is significantly
+    /// correlated or larger than claimed, nor its observable's common scale is, nor its
+    /// C/N0 below its own recent level.
+    pub fn inflation(
+        &self,
+        sat: SatId,
+        observable: Observable,
+        t_s: f64,
+        cn0_dbhz: Option<f64>,
+    ) -> f64 {
         if !self.is_on() {
             return 1.0;
         }
+        let floor = self
+            .cn0
+            .floor(sat, t_s, cn0_dbhz, self.max_gap_s, self.max_inflation);
+        self.judged(sat, observable, t_s).max(floor)
+    }
+
+    /// The factor from the residuals of the epochs before (see [`Self::inflation`]).
+    fn judged(&self, sat: SatId, observable: Observable, t_s: f64) -> f64 {
         let common = self
             .pooled
             .get(&observable)
@@ -209,17 +225,6 @@ impl ErrorCorrelation {
         };
         let (variance, correlation) = history.factors;
         (variance.max(common) * correlation).min(self.max_inflation)
-    }
-
-    /// The floor of `sat`'s inflation at `t_s` from its C/N0 of that epoch,
-    /// `cn0_dbhz`, against its reference from the epochs before ([`Cn0Deficit`]; 1 when
-    /// off).
-    pub fn cn0_floor(&self, sat: SatId, t_s: f64, cn0_dbhz: Option<f64>) -> f64 {
-        if !self.is_on() {
-            return 1.0;
-        }
-        self.cn0
-            .floor(sat, t_s, cn0_dbhz, self.max_gap_s, self.max_inflation)
     }
 
     /// Takes the innovations of one epoch at `t_s` (every channel of it, so that the
@@ -412,7 +417,7 @@ mod tests {
             judge.push(k as f64, &epoch);
         }
         (1..=SATELLITES)
-            .map(|prn| judge.inflation(sat(prn), Observable::Pseudorange, epochs as f64))
+            .map(|prn| judge.inflation(sat(prn), Observable::Pseudorange, epochs as f64, None))
             .collect()
     }
 
@@ -499,7 +504,7 @@ mod tests {
                 .collect()
         };
         let at = |judge: &ErrorCorrelation, prn: u16, t_s: f64| {
-            judge.inflation(sat(prn), Observable::Pseudorange, t_s)
+            judge.inflation(sat(prn), Observable::Pseudorange, t_s, None)
         };
         for k in 0..30 {
             judge.push(k as f64, &biased(k));
@@ -548,7 +553,7 @@ mod tests {
                     .collect();
                 judge.push(k as f64, &epoch);
                 let all_inflated = (1..=SATELLITES).all(|prn| {
-                    judge.inflation(sat(prn), Observable::Pseudorange, k as f64 + 1.0) >= 2.0
+                    judge.inflation(sat(prn), Observable::Pseudorange, k as f64 + 1.0, None) >= 2.0
                 });
                 if k >= 40 && all_inflated {
                     met[k - 40] += 1;
@@ -556,7 +561,7 @@ mod tests {
             }
             // The rates are another observable, judged apart.
             assert_eq!(
-                judge.inflation(sat(1), Observable::PseudorangeRate, 43.0),
+                judge.inflation(sat(1), Observable::PseudorangeRate, 43.0, None),
                 1.0
             );
         }

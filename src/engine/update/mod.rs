@@ -250,11 +250,7 @@ impl<M: MeasurementModel> Step<'_, M> {
         }
         let factors = channels
             .iter()
-            .map(|c| {
-                judge
-                    .inflation(c.sat, c.observable, t_s)
-                    .max(judge.cn0_floor(c.sat, t_s, c.cn0_dbhz))
-            })
+            .map(|c| judge.inflation(c.sat, c.observable, t_s, c.cn0_dbhz))
             .collect();
         if self.learn {
             let epoch: Vec<ChannelInnovation> = channels
