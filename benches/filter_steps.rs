@@ -244,6 +244,7 @@ fn divergence_monitor_step(c: &mut Criterion) {
                 black_box(&state),
                 &fix,
                 &fix_covariance_enu_m2,
+                1.0,
                 None,
                 &config,
             );

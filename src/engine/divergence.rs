@@ -19,6 +19,15 @@
 //!   off by its velocity error), so its offset shrinks or grows by far more than the
 //!   GNSS's σ from one epoch to the next.
 //!
+//! - the disagreement stands under the GNSS position's covariance as the update weighed
+//!   it too: a receiver fix's claim scaled by the consistency judge
+//!   (`loose.fix_consistency`). Under the bare claim (0.7 m) the foliage's fixes, 10–15 m
+//!   off in the same direction for seconds, put a sound filter beyond 5σ: on the
+//!   consumer-MEMS hour (seed 4, docs/results.md) the monitor reset it there, the start in
+//!   motion took its heading from those fixes, and the filter ran off by kilometres. The
+//!   claim still decides what follows (a leap, a dispute): the published covariance is
+//!   widened whenever the two disagree under it, which costs nothing when the filter is
+//!   right, while a reset throws a sound filter away.
 //! - the disagreement did not appear as a GNSS jump: an offset that leaps beyond
 //!   [`DISAGREE_SIGMA`] between two consecutive epochs (at most [`MAX_EPOCH_GAP_S`] apart)
 //!   from an epoch that agreed is the GNSS moving, unless the GNSS velocity (Doppler, or
@@ -80,6 +89,9 @@ pub struct Disagreement {
     pub offset_enu_m: Vector3<f64>,
     /// The filter's position covariance plus the GNSS position's, ENU (m²).
     pub covariance_enu_m2: Matrix3<f64>,
+    /// The same with the GNSS position's covariance as the update weighed it (a receiver
+    /// fix's claim scaled by `loose.fix_consistency`), ENU (m²).
+    pub weighed_covariance_enu_m2: Matrix3<f64>,
     /// The Mahalanobis distance (σ) of the GNSS velocity from the filter's, when the GNSS
     /// gave a velocity: who moved when the offset leaps.
     pub velocity_sigmas: Option<f64>,
@@ -90,7 +102,8 @@ pub type GnssVelocityEnu = (Vector3<f64>, Matrix3<f64>);
 
 impl Disagreement {
     /// The filter's disagreement with the GNSS antenna position `gnss` of covariance
-    /// `gnss_covariance_enu_m2`, and with the GNSS velocity when there is one.
+    /// `gnss_covariance_enu_m2`, which the update weighed `gnss_weight_scale` (≥ 1) times
+    /// larger, and with the GNSS velocity when there is one.
     ///
     /// Choice: the filter's covariances are those of its IMU position and velocity; the
     /// lever arm's share through the attitude error and the body rate (centimetres and
@@ -99,6 +112,7 @@ impl Disagreement {
         prior: &FilterState,
         gnss: &Llh,
         gnss_covariance_enu_m2: &Matrix3<f64>,
+        gnss_weight_scale: f64,
         gnss_velocity: Option<&GnssVelocityEnu>,
         config: &Config,
     ) -> Self {
@@ -111,11 +125,13 @@ impl Disagreement {
             let filter_cov: Matrix3<f64> = prior.p.fixed_view::<3, 3>(DV, DV).into();
             mahalanobis(&(v_enu_mps - prior.nav.v_n), &(filter_cov + cov_enu_m2_s2))
         });
+        let filter_covariance_enu_m2 = position_covariance_enu_m2(&prior.nav.p, &prior.p);
         Self {
             t_s: prior.nav.t_s,
             offset_enu_m: rot * (earth::llh_to_ecef(gnss) - antenna_ecef_m),
-            covariance_enu_m2: position_covariance_enu_m2(&prior.nav.p, &prior.p)
-                + gnss_covariance_enu_m2,
+            covariance_enu_m2: filter_covariance_enu_m2 + gnss_covariance_enu_m2,
+            weighed_covariance_enu_m2: filter_covariance_enu_m2
+                + gnss_covariance_enu_m2 * gnss_weight_scale.max(1.0),
             velocity_sigmas,
         }
     }
@@ -130,6 +146,11 @@ impl Disagreement {
     /// positive definite.
     pub fn sigmas(&self) -> Option<f64> {
         mahalanobis(&self.offset_enu_m, &self.covariance_enu_m2)
+    }
+
+    /// The same under the GNSS covariance as the update weighed it.
+    fn weighed_sigmas(&self) -> Option<f64> {
+        mahalanobis(&self.offset_enu_m, &self.weighed_covariance_enu_m2)
     }
 }
 
@@ -208,6 +229,10 @@ impl DivergenceMonitor {
             self.dispute_offset_enu_m = Some(d.offset_enu_m);
             return false;
         }
+        if !d.weighed_sigmas().is_some_and(|s| s > DISAGREE_SIGMA) {
+            self.run = None;
+            return false;
+        }
         let continues = self.run.filter(|run| {
             d.t_s - run.last_t_s <= MAX_EPOCH_GAP_S
                 && d.offset_enu_m.angle(&run.last_offset_enu_m) <= MAX_TURN_RAD
@@ -253,6 +278,7 @@ mod tests {
             t_s,
             offset_enu_m: Vector3::new(east_m, 0.0, 0.0),
             covariance_enu_m2: Matrix3::identity(),
+            weighed_covariance_enu_m2: Matrix3::identity(),
             velocity_sigmas: None,
         }
     }
@@ -321,6 +347,34 @@ mod tests {
     }
 
     #[test]
+    fn only_a_disagreement_beyond_the_fixes_weighed_covariance_is_divergence() {
+        // Fixes 8–12 m east of a filter, one way, for ten epochs: 8σ and more under their
+        // claim of 1 m, within 3σ under the 25-fold variance the update weighed them with.
+        let mut monitor = DivergenceMonitor::default();
+        for k in 0..10 {
+            let t_s = f64::from(k);
+            let d = Disagreement {
+                weighed_covariance_enu_m2: Matrix3::identity() * 25.0,
+                ..epoch(t_s, 8.0 + f64::from(k % 5))
+            };
+            assert!(!monitor.check(t_s, Some(&d)), "epoch {k}");
+            assert_eq!(monitor.dispute_offset_enu_m(), None);
+        }
+        // Beyond 5σ under both, they are.
+        let verdicts: Vec<bool> = (10..14)
+            .map(|k| {
+                let t_s = f64::from(k);
+                let d = Disagreement {
+                    weighed_covariance_enu_m2: Matrix3::identity() * 25.0,
+                    ..epoch(t_s, 30.0)
+                };
+                monitor.check(t_s, Some(&d))
+            })
+            .collect();
+        assert_eq!(verdicts, [false, false, false, true]);
+    }
+
+    #[test]
     fn outliers_jumps_gaps_and_unjudged_epochs_start_no_divergence() {
         let mut monitor = DivergenceMonitor::default();
         // Outliers in turning directions: the GNSS is not consistent with itself. None
@@ -352,6 +406,7 @@ mod tests {
         // A covariance that is no covariance judges nothing.
         let mut broken = epoch(53.0, 50.0);
         broken.covariance_enu_m2 = -Matrix3::identity();
+        broken.weighed_covariance_enu_m2 = -Matrix3::identity();
         assert!(!monitor.check(53.0, Some(&broken)));
     }
 }

@@ -36,6 +36,7 @@ impl Engine {
             Measurement::Fix(f) => Some(IndependentGnss {
                 position: f.position,
                 covariance_enu_m2: position_covariance(f, &self.config),
+                weight_scale: report.fix_scales.first().copied().unwrap_or(1.0),
                 velocity: f.velocity_enu_mps.zip(f.velocity_covariance_enu_m2_s2),
             }),
             Measurement::Gnss(e) => single_point_if_gated(e, report, prior, &self.config),
@@ -46,6 +47,7 @@ impl Engine {
                 prior,
                 &g.position,
                 &g.covariance_enu_m2,
+                g.weight_scale,
                 g.velocity.as_ref(),
                 &self.config,
             )
@@ -81,6 +83,8 @@ pub(super) fn published_solution(state: &FilterState, monitor: &DivergenceMonito
 struct IndependentGnss {
     position: Llh,
     covariance_enu_m2: Matrix3<f64>,
+    /// The factor the update weighed `covariance_enu_m2` with (1: as claimed).
+    weight_scale: f64,
     velocity: Option<GnssVelocityEnu>,
 }
 
@@ -132,6 +136,7 @@ fn single_point_if_gated(
     Some(IndependentGnss {
         position: sol.pos_llh,
         covariance_enu_m2: to_enu(sol.covariance.fixed_view::<3, 3>(0, 0).into()),
+        weight_scale: 1.0,
         velocity,
     })
 }
