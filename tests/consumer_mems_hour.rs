@@ -5,6 +5,8 @@
 //! (params/imu_consumer_mems.yaml) and `constraints.platform: car`, must stay within the
 //! issue's bounds: 3D RMSE below 2.7 m (KF-GINS's figure on such a drive), the largest 3D
 //! error below 30 m wherever a fix came within the last 30 s, no non-finite solution.
+//! On seed 1: seeds 2–4 miss them in the street canyon (docs/results.md); seed 4 keeps
+//! the check that its foliage resets no sound filter.
 //!
 //! Before `loose.fix_outlier_sigma` akf_all reached 8.6 m RMSE here (it took the canyon's
 //! outliers nearly whole) and, without the platform's constraint, the divergence monitor
@@ -16,7 +18,7 @@ use std::path::{Path, PathBuf};
 use adaptive_gnss_ins::config::{FilterVariant, VARIANTS};
 use adaptive_gnss_ins::ros::node::params::config_from_files;
 use adaptive_gnss_ins::sim::{Scenario, ScenarioSpec};
-use adaptive_gnss_ins::tools::compare::{compare_bag, NamedConfig};
+use adaptive_gnss_ins::tools::compare::{compare_bag, ComparisonRow, NamedConfig};
 use adaptive_gnss_ins::tools::scoring::SessionReport;
 use adaptive_gnss_ins::tools::simulate::{simulate, TRUTH_TOPIC};
 
@@ -55,10 +57,11 @@ fn largest_error_with_a_fix_m(report: &SessionReport) -> f64 {
     largest_m
 }
 
-/// The hour simulated into a bag in a temporary folder (kept alive by the first).
-fn hour_bag() -> (tempfile::TempDir, PathBuf) {
+/// The hour simulated with `seed` into a bag in a temporary folder (kept alive by the
+/// first).
+fn hour_bag(seed: u64) -> (tempfile::TempDir, PathBuf) {
     let yaml = std::fs::read_to_string(repo("tests/data/consumer_mems_hour.yaml")).unwrap();
-    let scenario = Scenario::new(ScenarioSpec::from_yaml(&yaml).unwrap(), SEED).unwrap();
+    let scenario = Scenario::new(ScenarioSpec::from_yaml(&yaml).unwrap(), seed).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let bag = dir.path().join("hour.mcap");
     simulate(&scenario, &bag).unwrap();
@@ -68,15 +71,8 @@ fn hour_bag() -> (tempfile::TempDir, PathBuf) {
 /// Runs each of `variants` with `files` and the car's constraint over the hour and asserts
 /// the bounds.
 fn assert_the_hours_bounds(files: &[&str], variants: &[FilterVariant]) {
-    let (_dir, bag) = hour_bag();
-    let files: Vec<PathBuf> = files.iter().map(|f| repo(f)).collect();
-    let mut base = config_from_files(&files).unwrap();
-    base.set_parameter("constraints.platform", "car").unwrap();
-    let configs: Vec<NamedConfig> = variants
-        .iter()
-        .map(|&variant| NamedConfig::of_variant(&base, variant))
-        .collect();
-    for (row, report) in compare_bag(&bag, &configs, TRUTH_TOPIC).unwrap() {
+    let (_dir, bag) = hour_bag(SEED);
+    for (row, report) in compare_in_a_car(&bag, files, variants) {
         let largest_m = largest_error_with_a_fix_m(&report);
         println!(
             "{:<13} 3D RMSE {:6.3} m, largest 3D error with a fix within {FIX_WITHIN_S} s {:6.2} m over {} epochs",
@@ -96,6 +92,48 @@ fn assert_the_hours_bounds(files: &[&str], variants: &[FilterVariant]) {
             largest_m < MAX_ERROR_3D_M,
             "{}: largest 3D error {largest_m:.2} m",
             row.filter
+        );
+    }
+}
+
+/// Each of `variants` with `files` and the car's constraint over `bag`.
+fn compare_in_a_car(
+    bag: &Path,
+    files: &[&str],
+    variants: &[FilterVariant],
+) -> Vec<(ComparisonRow, SessionReport)> {
+    let files: Vec<PathBuf> = files.iter().map(|f| repo(f)).collect();
+    let mut base = config_from_files(&files).unwrap();
+    base.set_parameter("constraints.platform", "car").unwrap();
+    let configs: Vec<NamedConfig> = variants
+        .iter()
+        .map(|&variant| NamedConfig::of_variant(&base, variant))
+        .collect();
+    compare_bag(bag, &configs, TRUTH_TOPIC).unwrap()
+}
+
+/// Seed 4's foliage (900–1100 s): fixes 10–15 m off in one direction for seconds, beyond
+/// 5σ of their claimed 0.7 m but not of the 20–25-fold covariance the consistency judge
+/// weighs them with. The monitor used to reset the sound filter there; the start in
+/// motion took its heading from those fixes and the ekf ran off by kilometres (3D RMSE
+/// 72.7 m, mean NEES 5737, docs/results.md). Now 7.6 m, most of it the street canyon's
+/// biased fixes, which every variant follows (the bounds of the other tests hold on seed
+/// 1 only); 10 m leaves room for those.
+#[test]
+fn the_foliages_consistent_fixes_reset_no_sound_filter_on_seed_4() {
+    let (_dir, bag) = hour_bag(4);
+    let files = [
+        "params/defaults.yaml",
+        "params/ekf_loose.yaml",
+        "params/imu_consumer_mems.yaml",
+    ];
+    for (row, _) in compare_in_a_car(&bag, &files, &[FilterVariant::Ekf]) {
+        println!("{:<13} 3D RMSE {:6.3} m", row.filter, row.pos_rmse_3d_m);
+        assert!(
+            row.pos_rmse_3d_m < 10.0,
+            "{}: {:.3} m",
+            row.filter,
+            row.pos_rmse_3d_m
         );
     }
 }
