@@ -5,8 +5,8 @@
 //! (params/imu_consumer_mems.yaml) and `constraints.platform: car`, must stay within the
 //! issue's bounds: 3D RMSE below 2.7 m (KF-GINS's figure on such a drive), the largest 3D
 //! error below 30 m wherever a fix came within the last 30 s, no non-finite solution.
-//! On seed 1: seeds 2–4 miss them in the street canyon (docs/results.md); seed 4 keeps
-//! the check that its foliage resets no sound filter.
+//! On seed 1: seeds 2–4 miss them (docs/results.md); seed 4 keeps two checks, that its
+//! foliage resets no sound filter and that its canyon pulls no tightly-coupled one off.
 //!
 //! Before `loose.fix_outlier_sigma` akf_all reached 8.6 m RMSE here (it took the canyon's
 //! outliers nearly whole) and, without the platform's constraint, the divergence monitor
@@ -131,6 +131,29 @@ fn the_foliages_consistent_fixes_reset_no_sound_filter_on_seed_4() {
         println!("{:<13} 3D RMSE {:6.3} m", row.filter, row.pos_rmse_3d_m);
         assert!(
             row.pos_rmse_3d_m < 10.0,
+            "{}: {:.3} m",
+            row.filter,
+            row.pos_rmse_3d_m
+        );
+    }
+}
+
+/// Seed 4's street canyon (2000–2150 s) leaves five satellites or fewer, too few for the
+/// error-correlation judge's parity fit; one of them, NLOS 10–16 m off, passed the gate
+/// and pulled the tightly-coupled ekf 20–32 m off at a σ of 2 m (3D RMSE 5.60 m, mean
+/// NEES 88, docs/results.md). Judged by its innovations it is deweighted: 1.61 m, 2.6.
+/// The bound is the 2.7 m, which seed 1 meets too.
+#[test]
+fn seed_4s_canyon_pulls_no_tightly_coupled_filter_off() {
+    let (_dir, bag) = hour_bag(4);
+    let files = ["params/defaults.yaml", "params/imu_consumer_mems.yaml"];
+    for (row, _) in compare_in_a_car(&bag, &files, &[FilterVariant::Ekf]) {
+        println!(
+            "{:<13} 3D RMSE {:6.3} m, mean NEES {:.2}",
+            row.filter, row.pos_rmse_3d_m, row.nees_mean
+        );
+        assert!(
+            row.pos_rmse_3d_m < MAX_RMSE_3D_M,
             "{}: {:.3} m",
             row.filter,
             row.pos_rmse_3d_m

@@ -45,6 +45,9 @@
 //! floored at once by [`Cn0Deficit`] (SIGMA-Δ), epochs before the residuals can show it:
 //! the default drive's foliage needed an inflation of its size from its first epoch
 //! (docs/results.md, the oracle).
+//! Choice (too few satellites): an epoch's channels too few for the parity fit (a street
+//! canyon's 4–5) are judged by their innovations over √(H P⁻ Hᵀ + R) instead
+//! ([`ErrorCorrelation::push_innovations`]).
 //! Choice (the mean): not removed; a constant bias is the extreme of correlation.
 //! Choice (the gate): the gate keeps the variance without the inflation, since a correlated
 //! error's size at one epoch is its marginal σ; only its averaging is wrong.
@@ -108,6 +111,8 @@ pub struct ChannelInnovation {
     pub y: f64,
     /// Its variance R before any inflation.
     pub r: f64,
+    /// The filter's share of its predicted variance, H P⁻ Hᵀ.
+    pub hph: f64,
     /// The satellite's C/N0 (dB-Hz), when reported.
     pub cn0_dbhz: Option<f64>,
     /// Coefficients of the errors common to every satellite of the observable: position
@@ -245,6 +250,7 @@ impl ErrorCorrelation {
             let geometry: Vec<[f64; COMMON_COLUMNS]> = of.iter().map(|c| c.common).collect();
             let weights: Vec<f64> = of.iter().map(|c| 1.0 / c.r).collect();
             let Some(residuals) = scaled_residuals(&values, &geometry, &weights) else {
+                self.push_innovations(t_s, &of);
                 continue;
             };
             let mut squares = Vec::with_capacity(of.len());
@@ -271,6 +277,26 @@ impl ErrorCorrelation {
         self.channels
             .retain(|_, h| h.samples.back().is_some_and(|(t, _)| t_s - t <= max_gap_s));
         self.cn0.forget_older_than(t_s, max_gap_s);
+    }
+}
+
+impl ErrorCorrelation {
+    /// Takes an epoch's channels of one observable that are too few for the parity fit
+    /// (fewer than [`COMMON_COLUMNS`] + 2): each innovation divided by the square root of
+    /// its predicted variance H P⁻ Hᵀ + R, into its channel's history only.
+    ///
+    /// Choice: a street canyon leaves 4–5 satellites, and judged nothing: on the
+    /// consumer-MEMS hour (seed 4) one NLOS satellite 10–16 m off (3–5σ of its predicted
+    /// variance, epoch after epoch, beside the others' 0–1σ) pulled the filter 20–32 m off
+    /// at a σ of 2 m. The filter's own error is then charged to every satellite in so far
+    /// as P does not cover it: cautious, where nothing else can judge. Not pooled, since
+    /// that error is common to them.
+    fn push_innovations(&mut self, t_s: f64, of: &[&ChannelInnovation]) {
+        for c in of {
+            let x = c.y / (c.hph + c.r).sqrt();
+            let history = self.channels.entry((c.sat, c.observable)).or_default();
+            history.push(t_s, x, self.max_gap_s, self.window, &self.chi2_99);
+        }
     }
 }
 
@@ -400,23 +426,35 @@ mod tests {
 
     /// Runs `epochs` epochs of range innovations of σ 1 m, `error(prn, rng)` each, and
     /// returns the inflation of every satellite at the next epoch.
-    fn run(epochs: usize, mut error: impl FnMut(u16, &mut ChaCha8Rng) -> f64) -> Vec<f64> {
+    fn run(epochs: usize, error: impl FnMut(u16, &mut ChaCha8Rng) -> f64) -> Vec<f64> {
+        run_with(SATELLITES, 0.0, epochs, error)
+    }
+
+    /// [`run`] with `satellites` satellites and the filter's share `hph` (m²) of each
+    /// innovation's predicted variance.
+    fn run_with(
+        satellites: u16,
+        hph: f64,
+        epochs: usize,
+        mut error: impl FnMut(u16, &mut ChaCha8Rng) -> f64,
+    ) -> Vec<f64> {
         let mut judge = ErrorCorrelation::new(true, 25.0, 2.0);
         let mut rng = ChaCha8Rng::seed_from_u64(3);
         for k in 0..epochs {
-            let epoch: Vec<ChannelInnovation> = (1..=SATELLITES)
+            let epoch: Vec<ChannelInnovation> = (1..=satellites)
                 .map(|prn| ChannelInnovation {
                     sat: sat(prn),
                     observable: Observable::Pseudorange,
                     y: error(prn, &mut rng),
                     r: 1.0,
+                    hph,
                     cn0_dbhz: None,
                     common: common(prn),
                 })
                 .collect();
             judge.push(k as f64, &epoch);
         }
-        (1..=SATELLITES)
+        (1..=satellites)
             .map(|prn| judge.inflation(sat(prn), Observable::Pseudorange, epochs as f64, None))
             .collect()
     }
@@ -430,6 +468,21 @@ mod tests {
         let inflations = run(60, |_, rng| white(rng));
         let inflated = inflations.iter().filter(|&&f| f > 1.0).count();
         assert!(inflated <= 1, "{inflations:?}");
+    }
+
+    #[test]
+    fn too_few_satellites_for_the_fit_are_judged_by_their_innovations() {
+        // Five satellites (one short of the parity fit), innovations of predicted
+        // variance 2 m² (1 of the filter, 1 of R); one satellite 6 m off (an NLOS bias,
+        // 4σ) is inflated alone, the others, of their predicted size, are not.
+        let sigma_m = 2.0f64.sqrt();
+        let inflations = run_with(5, 1.0, 40, |prn, rng| {
+            let bias_m = if prn == 2 { 6.0 } else { 0.0 };
+            bias_m + sigma_m * white(rng)
+        });
+        assert!(inflations[1] > 10.0, "{inflations:?}");
+        let others = inflations.iter().filter(|&&f| f > 1.0).count();
+        assert!(others <= 2, "{inflations:?}");
     }
 
     #[test]
@@ -498,6 +551,7 @@ mod tests {
                         (-1f64).powi(k as i32 + i32::from(prn))
                     },
                     r: 1.0,
+                    hph: 0.0,
                     cn0_dbhz: None,
                     common: common(prn),
                 })
@@ -547,6 +601,7 @@ mod tests {
                         observable: Observable::Pseudorange,
                         y: sigma * white(&mut rng),
                         r: 1.0,
+                        hph: 0.0,
                         cn0_dbhz: None,
                         common: common(prn),
                     })
@@ -586,6 +641,7 @@ mod tests {
                     observable: Observable::Pseudorange,
                     y: white(&mut rng),
                     r: 1.0,
+                    hph: 0.0,
                     cn0_dbhz: None,
                     common: common(prn),
                 })

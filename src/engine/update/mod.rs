@@ -191,7 +191,8 @@ impl<M: MeasurementModel> Step<'_, M> {
             self.model.report_noise(&mut self.report, i, verdict);
         }
         let y = innovations(lin);
-        let correlated = self.judge_correlation(lin, channels, &y, &r);
+        let hph: Vec<f64> = scalars.iter().map(|s| s.hph).collect();
+        let correlated = self.judge_correlation(lin, channels, &y, &r, &hph);
         self.report.correlated_measurements = correlated.iter().filter(|&&f| f > 1.0).count();
         let gate_rows: Vec<GateRow> = (0..m)
             .map(|i| GateRow {
@@ -235,13 +236,15 @@ impl<M: MeasurementModel> Step<'_, M> {
 
     /// The factor on each row's variance `r` for its channel's error correlation
     /// ([`super::error_correlation`]), from the epochs before; then the judge takes this
-    /// epoch's innovations `y` (unless re-applied after a roll-back).
+    /// epoch's innovations `y`, with the filter's share `hph` of their variance (unless
+    /// re-applied after a roll-back).
     fn judge_correlation(
         &mut self,
         lin: &Linearization,
         channels: &[NoiseChannel],
         y: &[f64],
         r: &[f64],
+        hph: &[f64],
     ) -> Vec<f64> {
         let t_s = self.model.t_s();
         let judge = &mut self.adaptation.correlation;
@@ -267,6 +270,7 @@ impl<M: MeasurementModel> Step<'_, M> {
                         observable: c.observable,
                         y: y[i],
                         r: r[i],
+                        hph: hph[i],
                         cn0_dbhz: c.cn0_dbhz,
                         common: [row[first], row[first + 1], row[first + 2], row[clock]],
                     }
