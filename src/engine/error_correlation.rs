@@ -48,6 +48,14 @@
 //! Choice (too few satellites): an epoch's channels too few for the parity fit (a street
 //! canyon's 4–5) are judged by their innovations over √(H P⁻ Hᵀ + R) instead
 //! ([`ErrorCorrelation::push_innovations`]).
+//! Choice (a satellite just risen): until a channel's own history holds half the window,
+//! its variance test runs on its last [`RECENT_EPOCHS`] innovations over
+//! √(H P⁻ Hᵀ + R), from its third epoch on. A street turning in a canyon brings satellites
+//! into view NLOS-biased by 30–45 m; with seven in view the parity fit spreads three such
+//! biases over all, and a channel with no history was taken as claimed: on the consumer
+//! hour (seed 2) two of them pulled the filter 14 m across the street at a σ of 2 m. The
+//! filter's own error is charged as in the choice above; the correlation, which needs
+//! the longer history, is not judged on innovations (they share the filter's error).
 //! Choice (the mean): not removed; a constant bias is the extreme of correlation.
 //! Choice (the gate): the gate keeps the variance without the inflation, since a correlated
 //! error's size at one epoch is its marginal σ; only its averaging is wrong.
@@ -81,6 +89,9 @@ pub const WINDOW_EPOCHS: usize = 20;
 /// The latest epochs whose mean square sets the variance factor when it exceeds the
 /// window's (see the module's choices).
 pub const RECENT_EPOCHS: usize = 6;
+/// Fewest consecutive pairs of a channel's innovations whose variance test counts while
+/// its own history is short (see the module's choices): three epochs.
+pub const FRESH_MIN_PAIRS: usize = 2;
 
 /// Epochs pooled for the common scale (see the module's choices).
 pub const POOLED_EPOCHS: usize = 3;
@@ -131,6 +142,9 @@ pub struct ErrorCorrelation {
     /// computed once (the quantile is an iterative inversion).
     chi2_99: Vec<f64>,
     channels: BTreeMap<(SatId, Observable), History>,
+    /// Per channel, its last innovations over √(H P⁻ Hᵀ + R): what judges a channel whose
+    /// own history is too short (a satellite that has just risen into view).
+    fresh: BTreeMap<(SatId, Observable), History>,
     /// Per observable, the squared normalised residuals of the last [`POOLED_EPOCHS`]
     /// epochs' channels that were not singled out, and the common scale they give.
     pooled: BTreeMap<Observable, Pooled>,
@@ -172,6 +186,7 @@ impl ErrorCorrelation {
             max_gap_s,
             chi2_99,
             channels: BTreeMap::new(),
+            fresh: BTreeMap::new(),
             pooled: BTreeMap::new(),
             cn0: Cn0Deficit::default(),
         }
@@ -185,6 +200,7 @@ impl ErrorCorrelation {
     /// Forgets every channel (after a filter reset).
     pub fn reset(&mut self) {
         self.channels.clear();
+        self.fresh.clear();
         self.pooled.clear();
         self.cn0.clear();
     }
@@ -226,7 +242,12 @@ impl ErrorCorrelation {
             .get(&(sat, observable))
             .filter(|h| h.is_current(t_s, self.max_gap_s, self.window / 2))
         else {
-            return common.min(self.max_inflation);
+            let fresh = self
+                .fresh
+                .get(&(sat, observable))
+                .filter(|h| h.is_current(t_s, self.max_gap_s, FRESH_MIN_PAIRS))
+                .map_or(1.0, |h| h.factors.0);
+            return fresh.max(common).min(self.max_inflation);
         };
         let (variance, correlation) = history.factors;
         (variance.max(common) * correlation).min(self.max_inflation)
@@ -240,6 +261,9 @@ impl ErrorCorrelation {
         }
         for c in epoch {
             self.cn0.push(c.sat, t_s, c.cn0_dbhz, self.max_gap_s);
+            let x = c.y / (c.hph + c.r).sqrt();
+            let history = self.fresh.entry((c.sat, c.observable)).or_default();
+            history.push(t_s, x, self.max_gap_s, RECENT_EPOCHS, &self.chi2_99);
         }
         for observable in [Observable::Pseudorange, Observable::PseudorangeRate] {
             let of: Vec<&ChannelInnovation> = epoch
@@ -275,6 +299,8 @@ impl ErrorCorrelation {
         }
         let max_gap_s = self.max_gap_s;
         self.channels
+            .retain(|_, h| h.samples.back().is_some_and(|(t, _)| t_s - t <= max_gap_s));
+        self.fresh
             .retain(|_, h| h.samples.back().is_some_and(|(t, _)| t_s - t <= max_gap_s));
         self.cn0.forget_older_than(t_s, max_gap_s);
     }
@@ -486,6 +512,43 @@ mod tests {
     }
 
     #[test]
+    fn a_satellite_just_risen_is_judged_by_its_innovations_from_its_third_epoch() {
+        // Ten satellites for 30 epochs; then two more rise, one 8σ off (an NLOS bias).
+        let mut judge = ErrorCorrelation::new(true, 25.0, 2.0);
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let mut inflation_of_the_biased = Vec::new();
+        for k in 0..34u16 {
+            let risen = if k >= 30 { 12 } else { SATELLITES };
+            let inflations: Vec<f64> = (1..=risen)
+                .map(|prn| judge.inflation(sat(prn), Observable::Pseudorange, f64::from(k), None))
+                .collect();
+            if k >= 30 {
+                inflation_of_the_biased.push(inflations[10]);
+                // The other one gets what a satellite long in view gets (the common
+                // scale, which the biased one's first epochs may raise).
+                assert_eq!(inflations[11], inflations[0], "epoch {k}");
+            }
+            let epoch: Vec<ChannelInnovation> = (1..=risen)
+                .map(|prn| ChannelInnovation {
+                    sat: sat(prn),
+                    observable: Observable::Pseudorange,
+                    y: if prn == 11 { 8.0 } else { 0.0 } + white(&mut rng),
+                    r: 1.0,
+                    hph: 0.0,
+                    cn0_dbhz: None,
+                    common: common(prn),
+                })
+                .collect();
+            judge.push(f64::from(k), &epoch);
+        }
+        // Judged on its fourth epoch, from its first three.
+        assert!(
+            inflation_of_the_biased[3] > 20.0,
+            "{inflation_of_the_biased:?}"
+        );
+    }
+
+    #[test]
     fn a_satellite_with_correlated_errors_is_inflated_alone() {
         let mut multipath = 0.0;
         let inflations = run(60, |prn, rng| {
@@ -564,14 +627,17 @@ mod tests {
             judge.push(k as f64, &biased(k));
         }
         assert_eq!(at(&judge, 2, 30.0), 1.0);
-        // Before its own test can judge it, the biased satellite gets no more than the
-        // others (the common scale, which its bias spread into them may raise).
+        // On its first two epochs the biased satellite gets no more than the others (the
+        // common scale, which its bias spread into them may raise); from its third, its
+        // innovations judge it, before its own history can.
         let mut judge = ErrorCorrelation::new(true, 25.0, 2.0);
-        for k in 0..5 {
+        for k in 0..2 {
             judge.push(k as f64, &biased(k));
         }
-        assert_eq!(at(&judge, 2, 5.0), at(&judge, 3, 5.0));
-        for k in 5..30 {
+        assert_eq!(at(&judge, 2, 2.0), at(&judge, 3, 2.0));
+        judge.push(2.0, &biased(2));
+        assert!(at(&judge, 2, 3.0) > 4.0 * at(&judge, 3, 3.0));
+        for k in 3..30 {
             judge.push(k as f64, &biased(k));
         }
         assert!(at(&judge, 2, 30.0) > 4.0 * at(&judge, 3, 30.0));
