@@ -304,9 +304,7 @@ impl ErrorCorrelation {
             .retain(|_, h| h.samples.back().is_some_and(|(t, _)| t_s - t <= max_gap_s));
         self.cn0.forget_older_than(t_s, max_gap_s);
     }
-}
 
-impl ErrorCorrelation {
     /// Takes an epoch's channels of one observable that are too few for the parity fit
     /// (fewer than [`COMMON_COLUMNS`] + 2): each innovation divided by the square root of
     /// its predicted variance H P⁻ Hᵀ + R, into its channel's history only.
