@@ -263,7 +263,8 @@ impl ErrorCorrelation {
             self.cn0.push(c.sat, t_s, c.cn0_dbhz, self.max_gap_s);
             let x = c.y / (c.hph + c.r).sqrt();
             let history = self.fresh.entry((c.sat, c.observable)).or_default();
-            history.push(t_s, x, self.max_gap_s, RECENT_EPOCHS, &self.chi2_99);
+            // Only its variance is judged (see the module's choices).
+            history.push(t_s, x, self.max_gap_s, RECENT_EPOCHS, false, &self.chi2_99);
         }
         for observable in [Observable::Pseudorange, Observable::PseudorangeRate] {
             let of: Vec<&ChannelInnovation> = epoch
@@ -285,7 +286,7 @@ impl ErrorCorrelation {
                 if !history.is_singled_out(t_s, self.max_gap_s, self.window / 2) && x.is_finite() {
                     squares.push(x * x);
                 }
-                history.push(t_s, x, self.max_gap_s, self.window, &self.chi2_99);
+                history.push(t_s, x, self.max_gap_s, self.window, true, &self.chi2_99);
             }
             // Of n residuals after the fit, about n − 4 are independent.
             let independent =
@@ -319,7 +320,7 @@ impl ErrorCorrelation {
         for c in of {
             let x = c.y / (c.hph + c.r).sqrt();
             let history = self.channels.entry((c.sat, c.observable)).or_default();
-            history.push(t_s, x, self.max_gap_s, self.window, &self.chi2_99);
+            history.push(t_s, x, self.max_gap_s, self.window, true, &self.chi2_99);
         }
     }
 }
@@ -354,8 +355,16 @@ impl Default for History {
 
 impl History {
     /// Takes the sample `x` of `t_s` and judges the window (`chi2_99`: χ²(n)'s 99 %
-    /// quantiles by n).
-    fn push(&mut self, t_s: f64, x: f64, max_gap_s: f64, window: usize, chi2_99: &[f64]) {
+    /// quantiles by n); its correlation only `with_correlation` (else 1).
+    fn push(
+        &mut self,
+        t_s: f64,
+        x: f64,
+        max_gap_s: f64,
+        window: usize,
+        with_correlation: bool,
+        chi2_99: &[f64],
+    ) {
         if !x.is_finite() {
             return;
         }
@@ -368,7 +377,11 @@ impl History {
         while self.samples.len() > window + 1 {
             self.samples.pop_front();
         }
-        let correlation = self.rho().map_or(1.0, |rho| (1.0 + rho) / (1.0 - rho));
+        let correlation = if with_correlation {
+            self.rho().map_or(1.0, |rho| (1.0 + rho) / (1.0 - rho))
+        } else {
+            1.0
+        };
         self.factors = (self.variance_ratio(chi2_99), correlation);
     }
 
