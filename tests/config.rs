@@ -131,6 +131,7 @@ const EVERY_KEY_CHANGED: &str = "
       velocity_sigma_mps: 0.3
       fix_outlier_sigma: 8.0
       fix_consistency: false
+      leap_hold_s: 120.0
     adaptive:
       window_size_m: 60
       min_samples: 20

@@ -5,8 +5,10 @@
 //! (params/imu_consumer_mems.yaml) and `constraints.platform: car`, must stay within the
 //! issue's bounds: 3D RMSE below 2.7 m (KF-GINS's figure on such a drive), the largest 3D
 //! error below 30 m wherever a fix came within the last 30 s, no non-finite solution.
-//! On seed 1: seeds 2–4 miss them (docs/results.md); seed 4 keeps two checks, that its
-//! foliage resets no sound filter and that its canyon pulls no tightly-coupled one off.
+//! On seed 1, and loosely coupled on seed 2 too, whose street canyon's fixes leap 46 m at
+//! once; the other seeds miss them (docs/results.md): seed 3 by the drift of its
+//! outages, and seed 4 keeps two checks, that its foliage resets no sound filter and that
+//! its canyon pulls no tightly-coupled one off.
 //!
 //! Before `loose.fix_outlier_sigma` akf_all reached 8.6 m RMSE here (it took the canyon's
 //! outliers nearly whole) and, without the platform's constraint, the divergence monitor
@@ -22,8 +24,6 @@ use adaptive_gnss_ins::tools::compare::{compare_bag, ComparisonRow, NamedConfig}
 use adaptive_gnss_ins::tools::scoring::SessionReport;
 use adaptive_gnss_ins::tools::simulate::{simulate, TRUTH_TOPIC};
 
-/// Seed of the simulation.
-const SEED: u64 = 1;
 /// The bounds.
 const MAX_RMSE_3D_M: f64 = 2.7;
 const MAX_ERROR_3D_M: f64 = 30.0;
@@ -68,10 +68,10 @@ fn hour_bag(seed: u64) -> (tempfile::TempDir, PathBuf) {
     (dir, bag)
 }
 
-/// Runs each of `variants` with `files` and the car's constraint over the hour and asserts
-/// the bounds.
-fn assert_the_hours_bounds(files: &[&str], variants: &[FilterVariant]) {
-    let (_dir, bag) = hour_bag(SEED);
+/// Runs each of `variants` with `files` and the car's constraint over the hour simulated
+/// with `seed` and asserts the bounds.
+fn assert_the_hours_bounds(seed: u64, files: &[&str], variants: &[FilterVariant]) {
+    let (_dir, bag) = hour_bag(seed);
     for (row, report) in compare_in_a_car(&bag, files, variants) {
         let largest_m = largest_error_with_a_fix_m(&report);
         println!(
@@ -116,18 +116,12 @@ fn compare_in_a_car(
 /// 5σ of their claimed 0.7 m but not of the 20–25-fold covariance the consistency judge
 /// weighs them with. The monitor used to reset the sound filter there; the start in
 /// motion took its heading from those fixes and the ekf ran off by kilometres (3D RMSE
-/// 72.7 m, mean NEES 5737, docs/results.md). Now 7.6 m, most of it the street canyon's
-/// biased fixes, which every variant follows (the bounds of the other tests hold on seed
-/// 1 only); 10 m leaves room for those.
+/// 72.7 m, mean NEES 5737, docs/results.md). Then 7.6 m, most of it the street canyon's
+/// biased fixes, which it followed; since they are held back by their leap, 2.4 m.
 #[test]
 fn the_foliages_consistent_fixes_reset_no_sound_filter_on_seed_4() {
     let (_dir, bag) = hour_bag(4);
-    let files = [
-        "params/defaults.yaml",
-        "params/ekf_loose.yaml",
-        "params/imu_consumer_mems.yaml",
-    ];
-    for (row, _) in compare_in_a_car(&bag, &files, &[FilterVariant::Ekf]) {
+    for (row, _) in compare_in_a_car(&bag, &LOOSE_FILES, &[FilterVariant::Ekf]) {
         println!("{:<13} 3D RMSE {:6.3} m", row.filter, row.pos_rmse_3d_m);
         assert!(
             row.pos_rmse_3d_m < 10.0,
@@ -161,28 +155,41 @@ fn seed_4s_canyon_pulls_no_tightly_coupled_filter_off() {
     }
 }
 
+/// The loosely-coupled variants of the paper that are weighed in the hour.
+const LOOSE_VARIANTS: [FilterVariant; 5] = [
+    FilterVariant::Ekf,
+    FilterVariant::AkfAll,
+    FilterVariant::AkfPartial,
+    FilterVariant::Iarf,
+    FilterVariant::ResidualAkf,
+];
+
+const LOOSE_FILES: [&str; 3] = [
+    "params/defaults.yaml",
+    "params/ekf_loose.yaml",
+    "params/imu_consumer_mems.yaml",
+];
+
 #[test]
 fn every_variant_loosely_coupled_meets_the_hours_bounds() {
-    assert_the_hours_bounds(
-        &[
-            "params/defaults.yaml",
-            "params/ekf_loose.yaml",
-            "params/imu_consumer_mems.yaml",
-        ],
-        &[
-            FilterVariant::Ekf,
-            FilterVariant::AkfAll,
-            FilterVariant::AkfPartial,
-            FilterVariant::Iarf,
-            FilterVariant::ResidualAkf,
-        ],
-    );
+    assert_the_hours_bounds(1, &LOOSE_FILES, &LOOSE_VARIANTS);
+}
+
+/// Seed 2's street canyon (2000–2150 s): the fixes leap 46 m at once (NLOS reception) and
+/// stay there, claiming 0.8 m. Every variant followed them and was then confidently wrong
+/// by 30 m (16.8 m 3D RMS in the canyon, 7.3–7.6 m over the hour, mean NEES 79–93,
+/// docs/results.md); held back by the leap (`loose.leap_hold_s`, src/engine/dispute.rs),
+/// 1.9–2.0 m.
+#[test]
+fn every_variant_loosely_coupled_meets_the_hours_bounds_on_seed_2() {
+    assert_the_hours_bounds(2, &LOOSE_FILES, &LOOSE_VARIANTS);
 }
 
 #[test]
 fn every_variant_tightly_coupled_meets_the_hours_bounds() {
     let variants: Vec<FilterVariant> = VARIANTS.iter().map(|spec| spec.variant).collect();
     assert_the_hours_bounds(
+        1,
         &["params/defaults.yaml", "params/imu_consumer_mems.yaml"],
         &variants,
     );

@@ -177,10 +177,12 @@ fn loose_config(variant: FilterVariant) -> Config {
     config.loose.fix_sigma_vertical_m = FIX_SIGMA_M;
     config.loose.velocity_sigma_mps = FIX_VELOCITY_SIGMA_MPS;
     // The paper's filters: no deweighting of outlying fixes by the engine (with it, on by
-    // default, the plain CKF of case 2 is already at IARF's 0.271 m), and the fixes'
-    // covariance taken as given.
+    // default, the plain CKF of case 2 is already at IARF's 0.271 m), the fixes'
+    // covariance taken as given, and no hold of fixes that leap (which leaves a lone
+    // outlier out while its leap awaits confirmation).
     config.loose.fix_outlier_sigma = 0.0;
     config.loose.fix_consistency = false;
+    config.loose.leap_hold_s = 0.0;
     config
 }
 

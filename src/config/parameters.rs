@@ -411,6 +411,20 @@ parameter_table! {
         /// fix_velocity_rescaled). false = take the claim as it is (the IARF paper's
         /// filters).
         fix_consistency: bool = true, unit "", range ANY, at_start;
+        /// When the fixes leap from agreeing with the filter to beyond 5 sigma of it
+        /// without the IMU (or the receiver's velocity) seeing a motion, and out of fixes
+        /// that moved little from epoch to epoch, one of the two is wrong: a dispute (WARN
+        /// on /diagnostics, published covariance widened by the offset). For at most this
+        /// long, until the fixes agree or leap back, the fixes are held back by the leap:
+        /// left out until two more epochs confirm it, then moved back by its offset with
+        /// their covariance grown by what that offset is known to, so that the filter
+        /// follows their motion but not the leap; counted (fix_leap_held). 0 = off: the
+        /// fixes are taken as they are (the IARF paper's filters).
+        // Choice: 300 s, longer than a street canyon's NLOS bias lasts at driving speed
+        // (tests/consumer_mems_hour.rs: 150 s), short enough that a filter that leapt
+        // itself (an IMU fault with fixes that carry no velocity) follows the fixes again.
+        leap_hold_s: f64 = 300.0,
+            unit "s", range Range::OffOrWithin(Interval::closed(1.0, 86400.0)), at_run_time;
     }
 
     /// Online measurement-noise estimation of the ERMAKF family, used by the variants

@@ -45,7 +45,10 @@
 //! monitor cannot tell which: it is a dispute ([`DivergenceMonitor::dispute_offset_enu_m`]),
 //! and the engine widens the covariance it publishes by the offset's outer product, so
 //! that either answer lies within it (the filter's own covariance, which the updates use,
-//! is left alone), and `/diagnostics` warns. Limit: a filter that has followed a
+//! is left alone), and `/diagnostics` warns. Loosely coupled, the receiver's fixes are
+//! then held back by the leap, so that the filter does not follow it
+//! ([`super::dispute`]); a receiver fix is judged before its update for that. Limit,
+//! tightly coupled (and loosely once a hold ends): a filter that has followed a
 //! confidently wrong GNSS all the way agrees with it again, and the dispute ends; its
 //! error is then beyond the published covariance (measured in docs/results.md).
 //!
@@ -57,6 +60,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 
+use super::dispute::{Dispute, Hold, RecentOffsets};
 use super::filter_state::FilterState;
 use super::output::position_covariance_enu_m2;
 use crate::config::Config;
@@ -185,8 +189,10 @@ struct Previous {
 pub struct DivergenceMonitor {
     run: Option<Run>,
     previous: Option<Previous>,
+    /// The offsets of the last judged epochs.
+    recent: RecentOffsets,
     /// The current disagreement began with a GNSS jump: no run until an epoch agrees.
-    gnss_jumped: bool,
+    dispute: Option<Dispute>,
     /// The offset of the last epoch checked, GNSS less filter (m), when it disagreed
     /// after a GNSS jump.
     dispute_offset_enu_m: Option<Vector3<f64>>,
@@ -200,6 +206,16 @@ impl DivergenceMonitor {
         let judged = epoch.and_then(|d| Some((d, d.sigmas()?)));
         let disagreeing = judged.filter(|(_, s)| *s > DISAGREE_SIGMA).map(|(d, _)| d);
         let previous = self.previous.filter(|p| t_s - p.t_s <= MAX_EPOCH_GAP_S);
+        let stands_out = judged.is_some_and(|(d, _)| self.recent.stand_out(&d.offset_enu_m));
+        if let Some((d, _)) = judged {
+            match self.hold() {
+                Some(Hold::MovedBack { offset_enu_m, .. }) => {
+                    self.recent.push(&(d.offset_enu_m - offset_enu_m));
+                }
+                Some(Hold::LeftOut { .. }) => {}
+                None => self.recent.push(&d.offset_enu_m),
+            }
+        }
         self.dispute_offset_enu_m = None;
         self.previous = Some(Previous {
             t_s,
@@ -208,23 +224,31 @@ impl DivergenceMonitor {
         });
         let Some(d) = disagreeing else {
             self.run = None;
-            self.gnss_jumped = false;
+            self.dispute = None;
             return false;
         };
-        if let Some(Previous {
-            judged: Some(before),
-            disagreed: false,
-            ..
-        }) = previous
+        if let Some((before, disagreed_before)) =
+            previous.and_then(|p| Some((p.judged?, p.disagreed)))
         {
             let step = Disagreement {
                 offset_enu_m: d.offset_enu_m - before.offset_enu_m,
                 ..*d
             };
             let leapt = step.sigmas().is_some_and(|s| s > DISAGREE_SIGMA);
-            self.gnss_jumped |= leapt && !d.velocity_disagrees();
+            let gnss_leapt = leapt && !d.velocity_disagrees();
+            // Choice: the fixes are held only after a leap beyond the fixes' covariance
+            // as the update weighed it, which the noise of a degraded stretch is not (in
+            // simulated foliage, fixes 5-15 m off every way under a claim of 0.7 m).
+            let fixes_leapt =
+                gnss_leapt && step.weighed_sigmas().is_some_and(|s| s > DISAGREE_SIGMA);
+            if gnss_leapt && !disagreed_before {
+                let hold = fixes_leapt && stands_out;
+                self.dispute = Some(Dispute::begin(d, &before.offset_enu_m, hold));
+            } else if let Some(dispute) = &mut self.dispute {
+                dispute.next(d, &before.offset_enu_m, leapt, fixes_leapt);
+            }
         }
-        if self.gnss_jumped {
+        if self.dispute.is_some() {
             self.run = None;
             self.dispute_offset_enu_m = Some(d.offset_enu_m);
             return false;
@@ -260,6 +284,11 @@ impl DivergenceMonitor {
     /// known (see the module documentation). None otherwise.
     pub fn dispute_offset_enu_m(&self) -> Option<Vector3<f64>> {
         self.dispute_offset_enu_m
+    }
+
+    /// The fixes' hold of the current dispute (see [`Dispute`]); None without one.
+    pub fn hold(&self) -> Option<Hold> {
+        self.dispute.as_ref()?.hold()
     }
 
     /// Forgets everything (after a reset).

@@ -54,6 +54,7 @@ mod adaptation;
 pub mod adaptive_noise;
 mod cn0_deficit;
 mod constraints;
+mod dispute;
 pub mod divergence;
 mod dual_antenna;
 mod error_correlation;
@@ -85,6 +86,7 @@ use crate::gnss::GnssEpoch;
 use crate::ins::ImuSample;
 
 use constraints::Constraints;
+use dispute::Hold;
 use divergence::DivergenceMonitor;
 use heading_bank::HeadingBank;
 use imu_screen::{ImuScreen, Screened};
@@ -821,6 +823,19 @@ impl Engine {
                 }
                 let w = state.compensate(&state.last_imu).w_ib_b_rad_s;
                 let before = state.as_ref().clone();
+                // A fix is judged before its update (see recovery::fix_disagreement).
+                let fix_diverged = match &p.measurement {
+                    Measurement::Fix(f) if report => {
+                        let d =
+                            recovery::fix_disagreement(&before, f, &self.adaptation, &self.config);
+                        Some(self.monitor.check(t, Some(&d)))
+                    }
+                    _ => None,
+                };
+                let hold = match &p.measurement {
+                    Measurement::Fix(_) => recovery::fix_hold(t, &self.monitor, &self.config),
+                    _ => None,
+                };
                 let adaptation = &mut self.adaptation;
                 let result = match &p.measurement {
                     Measurement::Gnss(e) => {
@@ -835,10 +850,21 @@ impl Engine {
                             report,
                         )
                     }
-                    Measurement::Fix(f) => {
-                        let mut model = update::FixMeasurement::new(f, &w, &self.config, state);
-                        update::apply(state, &mut model, adaptation, report)
-                    }
+                    Measurement::Fix(f) => match &hold {
+                        Some(Hold::LeftOut { .. }) => Ok(update::fix_left_out(f.t_s, adaptation)),
+                        _ => {
+                            let model = update::FixMeasurement::new(f, &w, &self.config, state);
+                            let mut model = match hold {
+                                Some(Hold::MovedBack {
+                                    offset_enu_m,
+                                    covariance_enu_m2,
+                                    ..
+                                }) => model.held_back(&offset_enu_m, &covariance_enu_m2),
+                                _ => model,
+                            };
+                            update::apply(state, &mut model, adaptation, report)
+                        }
+                    },
                     // Choice: the noise strategies and the process-noise scaling do not
                     // learn from a wheel speed (as from the motion constraints): its σ is
                     // the base controller's or the configured one, and the estimators stay
@@ -871,7 +897,14 @@ impl Engine {
                         // A wheel speed or a baseline heading is no GNSS input to
                         // monitor, and gives no report (as the motion constraints).
                         if report && gnss {
-                            let reset = self.monitor_divergence(&before, &p.measurement, &epoch);
+                            let reset = match (&p.measurement, fix_diverged) {
+                                (Measurement::Gnss(e), _) => {
+                                    self.monitor_gnss_epoch(&before, e, &epoch)
+                                }
+                                (_, diverged) => {
+                                    diverged.unwrap_or(false).then(|| self.reset_diverged(t))
+                                }
+                            };
                             out.push(Output::Epoch(epoch));
                             out.extend(reset);
                         }

@@ -33,18 +33,24 @@ impl Solution {
         position_covariance_enu_m2(&self.nav.p, &self.covariance)
     }
 
-    /// Adds the outer product of `offset_enu_m` (m) to the position covariance, as the
-    /// (δL, δλ, δh) block holds it: the solution may be off by that much beyond its own
-    /// covariance.
+    /// Adds the outer product of `offset_enu_m` (m) to the position covariance: the
+    /// solution may be off by that much beyond its own covariance.
     pub fn widen_position_by(&mut self, offset_enu_m: &Vector3<f64>) {
+        self.widen_position_by_covariance(&(offset_enu_m * offset_enu_m.transpose()));
+    }
+
+    /// Adds `covariance_enu_m2` (ENU, m²) to the position covariance, as the (δL, δλ, δh)
+    /// block holds it.
+    pub fn widen_position_by_covariance(&mut self, covariance_enu_m2: &Matrix3<f64>) {
         let (north, east) = earth::metres_per_radian(&self.nav.p);
-        let d = Vector3::new(
-            offset_enu_m.y / north,
-            offset_enu_m.x / east,
-            offset_enu_m.z,
+        #[rustfmt::skip]
+        let enu_to_block = Matrix3::new(
+            0.0, 1.0 / north, 0.0,
+            1.0 / east, 0.0, 0.0,
+            0.0, 0.0, 1.0,
         );
         let mut block = self.covariance.fixed_view_mut::<3, 3>(DP, DP);
-        block += d * d.transpose();
+        block += enu_to_block * covariance_enu_m2 * enu_to_block.transpose();
     }
 
     /// Covariance of the ENU velocity ((m/s)²).
@@ -257,6 +263,8 @@ pub struct EpochReport {
     /// velocity's, from the fixes before (`loose.fix_consistency`; 1: taken as claimed);
     /// empty in tight coupling.
     pub fix_scales: Vec<f64>,
+    /// The fix was held back by a GNSS leap (`loose.leap_hold_s`).
+    pub fix_held_back: bool,
     /// Pseudo-ranges and rates whose variance the error-correlation judge inflated.
     pub correlated_measurements: usize,
     /// The report of the epoch's time-differenced carrier-phase update, applied before the
@@ -285,6 +293,7 @@ impl EpochReport {
             fix_position_outlier: false,
             fix_velocity_outlier: false,
             fix_scales: Vec::new(),
+            fix_held_back: false,
             correlated_measurements: 0,
             carrier_phase_deltas: None,
         }
@@ -292,8 +301,9 @@ impl EpochReport {
 }
 
 /// The measurements deweighted so far (shown on /diagnostics): receiver fixes whose
-/// position or velocity was an outlier (`loose.fix_outlier_sigma`) or whose claimed
-/// position or velocity covariance was scaled (`loose.fix_consistency`), and pseudo-ranges
+/// position or velocity was an outlier (`loose.fix_outlier_sigma`), whose claimed
+/// position or velocity covariance was scaled (`loose.fix_consistency`) or which were held
+/// back by a GNSS leap (`loose.leap_hold_s`), and pseudo-ranges
 /// and rates whose variance was inflated for their errors' time correlation
 /// (`gnss.error_correlation`).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -302,6 +312,7 @@ pub struct Deweighted {
     pub velocity: u64,
     pub position_rescaled: u64,
     pub velocity_rescaled: u64,
+    pub held_back: u64,
     pub correlated: u64,
 }
 
@@ -315,6 +326,7 @@ impl Deweighted {
             |block: usize| u64::from(report.fix_scales.get(block).is_some_and(|&s| s > 1.0));
         self.position_rescaled += rescaled(0);
         self.velocity_rescaled += rescaled(1);
+        self.held_back += u64::from(report.fix_held_back);
     }
 }
 

@@ -4,11 +4,13 @@
 
 use nalgebra::Matrix3;
 
+use super::adaptation::Adaptation;
+use super::dispute::Hold;
 use super::divergence::{Disagreement, DivergenceMonitor, GnssVelocityEnu};
 use super::filter_state::FilterState;
 use super::output::{EpochReport, SatRejection, Solution};
-use super::update::{position_covariance, sigma_model};
-use super::{initializer, Engine, Measurement, Output, ResetReason};
+use super::update::{position_covariance, sigma_model, GnssFix};
+use super::{initializer, Engine, Output, ResetReason};
 use crate::config::Config;
 use crate::earth::{self, Llh};
 use crate::gnss::spp::{self, SppConfig};
@@ -24,38 +26,31 @@ pub const SPP_ABOVE_GATED_SHARE: f64 = 0.5;
 
 impl Engine {
     /// Feeds the monitor with the disagreement of `prior` (the filter before the update
-    /// by `m`, whose report is `report`); on divergence resets the filter and returns
-    /// the reset.
-    pub(super) fn monitor_divergence(
+    /// by the GNSS epoch `epoch`, tightly coupled, whose report is `report`); on
+    /// divergence resets the filter and returns the reset.
+    pub(super) fn monitor_gnss_epoch(
         &mut self,
         prior: &FilterState,
-        m: &Measurement,
+        epoch: &GnssEpoch,
         report: &EpochReport,
     ) -> Option<Output> {
-        let gnss = match m {
-            Measurement::Fix(f) => Some(IndependentGnss {
-                position: f.position,
-                covariance_enu_m2: position_covariance(f, &self.config),
-                weight_scale: report.fix_scales.first().copied().unwrap_or(1.0),
-                velocity: f.velocity_enu_mps.zip(f.velocity_covariance_enu_m2_s2),
-            }),
-            Measurement::Gnss(e) => single_point_if_gated(e, report, prior, &self.config),
-            Measurement::WheelSpeed(_) | Measurement::BaselineHeading(_) => None,
-        };
-        let disagreement = gnss.map(|g| {
+        let disagreement = single_point_if_gated(epoch, report, prior, &self.config).map(|g| {
             Disagreement::of(
                 prior,
                 &g.position,
                 &g.covariance_enu_m2,
-                g.weight_scale,
+                1.0,
                 g.velocity.as_ref(),
                 &self.config,
             )
         });
-        if !self.monitor.check(report.t_s, disagreement.as_ref()) {
-            return None;
-        }
-        let t_s = report.t_s;
+        self.monitor
+            .check(report.t_s, disagreement.as_ref())
+            .then(|| self.reset_diverged(report.t_s))
+    }
+
+    /// Resets the filter that the monitor found diverged at `t_s`, and returns the reset.
+    pub(super) fn reset_diverged(&mut self, t_s: f64) -> Output {
         log::error!(
             "the filter diverged from GNSS at t = {t_s:.3} s (beyond {} σ for {} s): re-initializing",
             super::divergence::DISAGREE_SIGMA,
@@ -64,27 +59,66 @@ impl Engine {
         self.divergence_resets += 1;
         self.diverged_at_t_s = Some(t_s);
         // Nothing of the diverged state is kept (see Initializer::after_divergence).
-        Some(self.reset(t_s, ResetReason::DivergedFromGnss))
+        self.reset(t_s, ResetReason::DivergedFromGnss)
     }
+}
+
+/// The disagreement of `prior` with the receiver fix `fix` (loose coupling), under the
+/// fix's covariance as the update will weigh it (`loose.fix_consistency`'s verdict on
+/// the fixes before).
+///
+/// Choice: judged before the update, so that the fix that leaps is held already (see
+/// [`super::dispute`]): taken as it was, it pulled the filter by the outlier bound's share
+/// of the leap (akf_all, which inflates its covariance for it, 30 m vertically).
+pub(super) fn fix_disagreement(
+    prior: &FilterState,
+    fix: &GnssFix,
+    adaptation: &Adaptation,
+    config: &Config,
+) -> Disagreement {
+    let velocity = fix.velocity_enu_mps.zip(fix.velocity_covariance_enu_m2_s2);
+    Disagreement::of(
+        prior,
+        &fix.position,
+        &position_covariance(fix, config),
+        adaptation.fix[0].scale(),
+        velocity.as_ref(),
+        config,
+    )
 }
 
 /// The solution of `state` as the engine publishes it: while the monitor holds a dispute
 /// (a GNSS leap the IMU does not support: the GNSS or the filter is wrong, it cannot tell
-/// which), its position covariance widened by the offset's outer product.
+/// which), its position covariance widened by the offset's outer product; while the fixes
+/// are held back by the leap, by the covariance the held position is known to as well
+/// (the filter takes each held fix as new, but the offset that moves them back is one).
 pub(super) fn published_solution(state: &FilterState, monitor: &DivergenceMonitor) -> Solution {
     let mut solution = state.solution();
     if let Some(offset_enu_m) = monitor.dispute_offset_enu_m() {
         solution.widen_position_by(&offset_enu_m);
     }
+    if let Some(Hold::MovedBack {
+        covariance_enu_m2, ..
+    }) = monitor.hold()
+    {
+        solution.widen_position_by_covariance(&covariance_enu_m2);
+    }
     solution
+}
+
+/// The hold by a GNSS leap (see [`super::dispute`]) that the update applies to the fix at
+/// `t_s`: the monitor's, for at most `loose.leap_hold_s` after the leap (0: never).
+pub(super) fn fix_hold(t_s: f64, monitor: &DivergenceMonitor, config: &Config) -> Option<Hold> {
+    let hold_s = config.loose.leap_hold_s;
+    monitor
+        .hold()
+        .filter(|h| hold_s > 0.0 && t_s - h.since_t_s() <= hold_s)
 }
 
 /// A GNSS position independent of the filter, and its velocity when there is one.
 struct IndependentGnss {
     position: Llh,
     covariance_enu_m2: Matrix3<f64>,
-    /// The factor the update weighed `covariance_enu_m2` with (1: as claimed).
-    weight_scale: f64,
     velocity: Option<GnssVelocityEnu>,
 }
 
@@ -136,7 +170,6 @@ fn single_point_if_gated(
     Some(IndependentGnss {
         position: sol.pos_llh,
         covariance_enu_m2: to_enu(sol.covariance.fixed_view::<3, 3>(0, 0).into()),
-        weight_scale: 1.0,
         velocity,
     })
 }

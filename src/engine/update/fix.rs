@@ -55,6 +55,9 @@ pub struct FixMeasurement<'a> {
     /// The ENU frame at the prior, held for every state the update predicts from, so that
     /// every cubature point is expressed in one frame.
     rot_ecef_to_enu: Matrix3<f64>,
+    /// The covariance the position is known to beyond its own when it is held back by a
+    /// GNSS leap ([`FixMeasurement::held_back`]).
+    hold_covariance_enu_m2: Option<Matrix3<f64>>,
 }
 
 impl<'a> FixMeasurement<'a> {
@@ -72,6 +75,19 @@ impl<'a> FixMeasurement<'a> {
             config,
             fix_ecef_m: earth::llh_to_ecef(&fix.position),
             rot_ecef_to_enu: earth::rot_ecef_to_enu(&prior.nav.p),
+            hold_covariance_enu_m2: None,
+        }
+    }
+
+    /// The fix held back by a GNSS leap (see `engine::dispute`): its position moved back
+    /// by the leap's offset `offset_enu_m` (GNSS less filter, m), its covariance grown by
+    /// `covariance_enu_m2` (m²).
+    pub fn held_back(self, offset_enu_m: &Vector3<f64>, covariance_enu_m2: &Matrix3<f64>) -> Self {
+        let offset_ecef_m = self.rot_ecef_to_enu.transpose() * offset_enu_m;
+        Self {
+            fix_ecef_m: self.fix_ecef_m - offset_ecef_m,
+            hold_covariance_enu_m2: Some(*covariance_enu_m2),
+            ..self
         }
     }
 
@@ -103,7 +119,7 @@ impl MeasurementModel for FixMeasurement<'_> {
         MeasurementKind::Fix
     }
 
-    fn linearize(&mut self, state: &mut FilterState, _report: &mut EpochReport) -> Linearization {
+    fn linearize(&mut self, state: &mut FilterState, report: &mut EpochReport) -> Linearization {
         let geo = AntennaGeometry::new(
             &state.nav,
             &self.config.mounting.lever_arm_b_m,
@@ -113,8 +129,10 @@ impl MeasurementModel for FixMeasurement<'_> {
         let m = predicted.len();
         let mut rows = geo.position_rows().to_vec();
         let mut r = DMatrix::zeros(m, m);
+        let held = self.hold_covariance_enu_m2.unwrap_or_else(Matrix3::zeros);
         r.view_mut((0, 0), (3, 3))
-            .copy_from(&position_covariance(self.fix, self.config));
+            .copy_from(&(position_covariance(self.fix, self.config) + held));
+        report.fix_held_back = self.hold_covariance_enu_m2.is_some();
         if self.fix.velocity_enu_mps.is_some() {
             rows.extend(geo.velocity_rows());
             r.view_mut((3, 3), (3, 3))

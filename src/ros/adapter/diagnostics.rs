@@ -49,6 +49,7 @@ impl RosAdapter {
             ("fix_velocity_outliers", outliers.velocity),
             ("fix_position_rescaled", outliers.position_rescaled),
             ("fix_velocity_rescaled", outliers.velocity_rescaled),
+            ("fix_leap_held", outliers.held_back),
             ("correlated_measurements", outliers.correlated),
         ] {
             values.push(key_value(key, n.to_string()));
