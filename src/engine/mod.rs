@@ -345,7 +345,11 @@ impl Engine {
     /// [`Engine::gnss_dispute_offset_enu_m`]). None before the start.
     pub fn published_solution(&self) -> Option<Solution> {
         let state = self.state()?;
-        Some(recovery::published_solution(state, &self.monitor))
+        Some(recovery::published_solution(
+            state,
+            &self.monitor,
+            &self.config,
+        ))
     }
 
     /// The GNSS position less the filter's (ENU, m) while the GNSS and the filter disagree
@@ -739,7 +743,8 @@ impl Engine {
                 if let Some(published) = bank.published() {
                     let t_s = published.last_imu.t_s;
                     if output_due(self.config.output.rate_hz, &mut self.last_output_t_s, t_s) {
-                        let solution = recovery::published_solution(published, &self.monitor);
+                        let solution =
+                            recovery::published_solution(published, &self.monitor, &self.config);
                         out.push(Output::Solution(Box::new(solution)));
                     }
                 }
@@ -772,7 +777,7 @@ impl Engine {
                 // published: the solutions of a start it found.
                 let t_s = state.last_imu.t_s;
                 if output_due(self.config.output.rate_hz, &mut self.last_output_t_s, t_s) {
-                    let solution = recovery::published_solution(state, &self.monitor);
+                    let solution = recovery::published_solution(state, &self.monitor, &self.config);
                     out.push(Output::Solution(Box::new(solution)));
                 }
                 let moving = state.nav.v_n.xy().norm() >= self.config.init.heading_min_speed_mps;

@@ -11,7 +11,7 @@ use super::filter_state::FilterState;
 use super::output::{EpochReport, SatRejection, Solution};
 use super::update::{position_covariance, sigma_model, GnssFix};
 use super::{initializer, Engine, Output, ResetReason};
-use crate::config::Config;
+use crate::config::{Config, Coupling};
 use crate::earth::{self, Llh};
 use crate::gnss::spp::{self, SppConfig};
 use crate::gnss::GnssEpoch;
@@ -92,27 +92,32 @@ pub(super) fn fix_disagreement(
 /// which), its position covariance widened by the offset's outer product; while the fixes
 /// are held back by the leap, by the covariance the held position is known to as well
 /// (the filter takes each held fix as new, but the offset that moves them back is one).
-pub(super) fn published_solution(state: &FilterState, monitor: &DivergenceMonitor) -> Solution {
+pub(super) fn published_solution(
+    state: &FilterState,
+    monitor: &DivergenceMonitor,
+    config: &Config,
+) -> Solution {
     let mut solution = state.solution();
     if let Some(offset_enu_m) = monitor.dispute_offset_enu_m() {
         solution.widen_position_by(&offset_enu_m);
     }
     if let Some(Hold::MovedBack {
         covariance_enu_m2, ..
-    }) = monitor.hold()
+    }) = fix_hold(state.nav.t_s, monitor, config)
     {
         solution.widen_position_by_covariance(&covariance_enu_m2);
     }
     solution
 }
 
-/// The hold by a GNSS leap (see [`super::dispute`]) that the update applies to the fix at
-/// `t_s`: the monitor's, for at most `loose.leap_hold_s` after the leap (0: never).
+/// The hold by a GNSS leap (see [`super::dispute`]) that applies at `t_s`: the monitor's,
+/// loosely coupled, for at most `loose.leap_hold_s` after the leap (0: never).
 pub(super) fn fix_hold(t_s: f64, monitor: &DivergenceMonitor, config: &Config) -> Option<Hold> {
     let hold_s = config.loose.leap_hold_s;
+    let loose = config.filter.coupling == Coupling::Loose;
     monitor
         .hold()
-        .filter(|h| hold_s > 0.0 && t_s - h.since_t_s() <= hold_s)
+        .filter(|h| loose && hold_s > 0.0 && t_s - h.since_t_s() <= hold_s)
 }
 
 /// A GNSS position independent of the filter, and its velocity when there is one.
