@@ -280,21 +280,10 @@ impl RecentOffsets {
 
 #[cfg(test)]
 mod tests {
-    use nalgebra::{Matrix3, Vector3};
+    use nalgebra::Vector3;
 
     use super::Hold;
     use crate::engine::divergence::{Disagreement, DivergenceMonitor};
-
-    /// The fixes `east_m` east of the filter (1 m σ, weighed as claimed), no velocity.
-    fn epoch(t_s: f64, east_m: f64) -> Disagreement {
-        Disagreement {
-            t_s,
-            offset_enu_m: Vector3::new(east_m, 0.0, 0.0),
-            covariance_enu_m2: Matrix3::identity(),
-            weighed_covariance_enu_m2: Matrix3::identity(),
-            velocity_sigmas: None,
-        }
-    }
 
     /// Checks the offsets `east_m` at 1 s epochs from `from_t_s`; after each, how the
     /// update takes the next fix: "-" as it is, "out" left out, "back N" moved back by N m.
@@ -305,7 +294,7 @@ mod tests {
             .map(|(k, &e)| {
                 let t_s = from_t_s + k as f64;
                 assert!(
-                    !monitor.check(t_s, Some(&epoch(t_s, e))),
+                    !monitor.check(t_s, Some(&Disagreement::east_of_filter(t_s, e))),
                     "divergence at {t_s} s"
                 );
                 match monitor.hold() {

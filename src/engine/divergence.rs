@@ -158,6 +158,21 @@ impl Disagreement {
     }
 }
 
+#[cfg(test)]
+impl Disagreement {
+    /// The GNSS `east_m` east of the filter at `t_s` (1 m σ, weighed as claimed), with no
+    /// GNSS velocity.
+    pub(crate) fn east_of_filter(t_s: f64, east_m: f64) -> Self {
+        Self {
+            t_s,
+            offset_enu_m: Vector3::new(east_m, 0.0, 0.0),
+            covariance_enu_m2: Matrix3::identity(),
+            weighed_covariance_enu_m2: Matrix3::identity(),
+            velocity_sigmas: None,
+        }
+    }
+}
+
 /// The Mahalanobis length of `x` under `covariance` (σ); None when the covariance is not
 /// positive definite.
 fn mahalanobis(x: &Vector3<f64>, covariance: &Matrix3<f64>) -> Option<f64> {
@@ -301,15 +316,8 @@ impl DivergenceMonitor {
 mod tests {
     use super::*;
 
-    /// The GNSS `east_m` east of the filter (1 m σ), with no GNSS velocity.
     fn epoch(t_s: f64, east_m: f64) -> Disagreement {
-        Disagreement {
-            t_s,
-            offset_enu_m: Vector3::new(east_m, 0.0, 0.0),
-            covariance_enu_m2: Matrix3::identity(),
-            weighed_covariance_enu_m2: Matrix3::identity(),
-            velocity_sigmas: None,
-        }
+        Disagreement::east_of_filter(t_s, east_m)
     }
 
     fn check(monitor: &mut DivergenceMonitor, t_s: f64, east_m: f64) -> bool {
