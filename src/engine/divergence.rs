@@ -258,9 +258,9 @@ impl DivergenceMonitor {
                 gnss_leapt && step.weighed_sigmas().is_some_and(|s| s > DISAGREE_SIGMA);
             if gnss_leapt && !disagreed_before {
                 let hold = fixes_leapt && stands_out;
-                self.dispute = Some(Dispute::begin(d, &before.offset_enu_m, hold));
+                self.dispute = Some(Dispute::begin(d, hold));
             } else if let Some(dispute) = &mut self.dispute {
-                dispute.next(d, &before.offset_enu_m, leapt, fixes_leapt);
+                dispute.next(d, leapt, fixes_leapt);
             }
         }
         if self.dispute.is_some() {
