@@ -415,7 +415,7 @@ parameter_table! {
         /// without the IMU (or the receiver's velocity) seeing a motion, and out of fixes
         /// that moved little from epoch to epoch, one of the two is wrong: a dispute (WARN
         /// on /diagnostics, published covariance widened by the offset). For at most this
-        /// long, until the fixes agree or leap back, the fixes are held back by the leap:
+        /// long, until the fixes agree, leap back or scatter like noise, they are held back:
         /// left out until two more epochs confirm it, then moved back by its offset with
         /// their covariance grown by what that offset is known to, so that the filter
         /// follows their motion but not the leap; counted (fix_leap_held). 0 = off: the

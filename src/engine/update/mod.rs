@@ -114,8 +114,8 @@ pub fn apply<M: MeasurementModel>(
     Ok(step.report)
 }
 
-/// The report of the fix at `t_s` left out of the update: held back by a GNSS leap whose
-/// return is not yet confirmed (see `engine::dispute`).
+/// The report of the fix at `t_s` left out of the update: held back by a leap of the
+/// fixes not yet confirmed (see `engine::dispute`).
 pub fn fix_left_out(t_s: f64, adaptation: &Adaptation) -> EpochReport {
     let mut report = EpochReport::new(t_s, MeasurementKind::Fix, adaptation.variant);
     report.fix_held_back = true;
