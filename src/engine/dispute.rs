@@ -12,7 +12,7 @@
 //!
 //! Choices:
 //! - A hold begins only with a leap out of fixes that moved little from epoch to epoch
-//!   ([`RecentOffsets::stand_out`]) and beyond 5σ of the fixes' covariance as the update
+//!   ([`RecentOffsets::newest_stands_out`]) and beyond 5σ of the fixes' covariance as the update
 //!   weighs it (`loose.fix_consistency`): a degraded stretch whose fixes wander (simulated
 //!   foliage) is no bias to hold.
 //! - A leap, the first one and any later one, is confirmed by [`CONFIRM_EPOCHS`] epochs
@@ -60,7 +60,7 @@ pub const CONFIRM_EPOCHS: u32 = 3;
 /// leap. Choice: 10, the consistency judge's window (`engine::fix_consistency`).
 pub const RECENT_EPOCHS: usize = 10;
 /// Share of a leap's length below which the fixes' typical step from epoch to epoch
-/// must lie for the leap to hold them ([`RecentOffsets::stand_out`]). Choice: one half.
+/// must lie for the leap to hold them ([`RecentOffsets::newest_stands_out`]). Choice: one half.
 pub const WANDER_SHARE: f64 = 0.5;
 /// Fewest steps of the recent offsets that tell how they wander.
 pub const MIN_STEPS: usize = 3;
@@ -221,9 +221,9 @@ impl Scatter {
     }
 }
 
-/// The offsets (GNSS less filter, ENU, m) of the last [`RECENT_EPOCHS`] judged epochs,
-/// less the held offset while a hold moves the fixes back: how the fixes wander about
-/// where the filter takes them to be.
+/// The offsets (GNSS less filter, ENU, m) of the newest judged epoch and the
+/// [`RECENT_EPOCHS`] before it, less the held offset while a hold moves the fixes back:
+/// how the fixes wander about where the filter takes them to be.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct RecentOffsets {
     offsets_enu_m: VecDeque<Vector3<f64>>,
@@ -231,32 +231,35 @@ pub struct RecentOffsets {
 
 impl RecentOffsets {
     pub fn push(&mut self, offset_enu_m: &Vector3<f64>) {
-        if self.offsets_enu_m.len() == RECENT_EPOCHS {
+        if self.offsets_enu_m.len() > RECENT_EPOCHS {
             self.offsets_enu_m.pop_front();
         }
         self.offsets_enu_m.push_back(*offset_enu_m);
     }
 
-    /// Whether a leap to `offset_enu_m` stands out of how the recent offsets wander: the
-    /// median of their steps from epoch to epoch is below [`WANDER_SHARE`] of its length,
-    /// or there are too few steps to tell.
+    /// Whether the newest offset, a leap, stands out of how the offsets before it wander:
+    /// the median of their steps from epoch to epoch is below [`WANDER_SHARE`] of its
+    /// length, or there are too few steps to tell.
     ///
     /// Choice: a degraded stretch (simulated foliage) moves the fixes by 5-15 m from epoch
     /// to epoch, and a hold there anchored the filter to one of them; a street canyon's
     /// leap of 30-130 m comes out of fixes that moved by a metre. The median, so that one
     /// outlier in the window (a step there and one back) does not hide the next leap.
-    pub fn stand_out(&self, offset_enu_m: &Vector3<f64>) -> bool {
-        let offsets = &self.offsets_enu_m;
-        let mut steps_m: Vec<f64> = offsets
-            .iter()
-            .zip(offsets.iter().skip(1))
+    pub fn newest_stands_out(&self) -> bool {
+        let Some(newest) = self.offsets_enu_m.back() else {
+            return true;
+        };
+        let before = self.offsets_enu_m.iter().take(self.offsets_enu_m.len() - 1);
+        let mut steps_m: Vec<f64> = before
+            .clone()
+            .zip(before.skip(1))
             .map(|(a, b)| (b - a).norm())
             .collect();
         if steps_m.len() < MIN_STEPS {
             return true;
         }
         steps_m.sort_by(f64::total_cmp);
-        steps_m[steps_m.len() / 2] < WANDER_SHARE * offset_enu_m.norm()
+        steps_m[steps_m.len() / 2] < WANDER_SHARE * newest.norm()
     }
 }
 

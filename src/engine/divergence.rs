@@ -221,7 +221,6 @@ impl DivergenceMonitor {
         let judged = epoch.and_then(|d| Some((d, d.sigmas()?)));
         let disagreeing = judged.filter(|(_, s)| *s > DISAGREE_SIGMA).map(|(d, _)| d);
         let previous = self.previous.filter(|p| t_s - p.t_s <= MAX_EPOCH_GAP_S);
-        let stands_out = judged.is_some_and(|(d, _)| self.recent.stand_out(&d.offset_enu_m));
         if let Some((d, _)) = judged {
             match self.hold() {
                 Some(Hold::MovedBack { offset_enu_m, .. }) => {
@@ -257,7 +256,7 @@ impl DivergenceMonitor {
             let fixes_leapt =
                 gnss_leapt && step.weighed_sigmas().is_some_and(|s| s > DISAGREE_SIGMA);
             if gnss_leapt && !disagreed_before {
-                let hold = fixes_leapt && stands_out;
+                let hold = fixes_leapt && self.recent.newest_stands_out();
                 self.dispute = Some(Dispute::begin(d, hold));
             } else if let Some(dispute) = &mut self.dispute {
                 dispute.next(d, leapt, fixes_leapt);
