@@ -95,9 +95,8 @@ impl Hold {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Dispute {
     since_t_s: f64,
-    /// The dispute began with a leap that holds the fixes.
-    holding: bool,
-    /// The offset at the leap and its combined covariance, once confirmed.
+    /// The offset at the leap and its combined covariance, once confirmed. With
+    /// `leap_epochs`, None: the fixes are not held (any more).
     held: Option<(Vector3<f64>, Matrix3<f64>)>,
     /// A leap of the fixes awaits confirmation: the epochs since it, its own included.
     leap_epochs: Option<u32>,
@@ -110,7 +109,6 @@ impl Dispute {
     pub fn begin(d: &Disagreement, hold: bool) -> Self {
         Self {
             since_t_s: d.t_s,
-            holding: hold,
             held: None,
             leap_epochs: hold.then_some(1),
             scatter: Scatter::default(),
@@ -122,7 +120,7 @@ impl Dispute {
     /// covariance the update weighed them with, and not the filter's: its velocity
     /// agrees with the GNSS's).
     pub fn next(&mut self, d: &Disagreement, leapt: bool, fixes_leapt: bool) {
-        if !self.holding {
+        if !self.holding() {
             return;
         }
         self.leap_epochs = match self.leap_epochs {
@@ -170,17 +168,18 @@ impl Dispute {
         }
     }
 
+    /// Whether the fixes are held: a leap awaits confirmation or holds them.
+    fn holding(&self) -> bool {
+        self.leap_epochs.is_some() || self.held.is_some()
+    }
+
     fn stop_holding(&mut self) {
-        self.holding = false;
         self.held = None;
         self.leap_epochs = None;
     }
 
     /// How the update takes the fix now; None: as it is.
     pub fn hold(&self) -> Option<Hold> {
-        if !self.holding {
-            return None;
-        }
         if self.leap_epochs.is_some() {
             return Some(Hold::LeftOut {
                 since_t_s: self.since_t_s,

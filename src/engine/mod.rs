@@ -829,17 +829,20 @@ impl Engine {
                 let w = state.compensate(&state.last_imu).w_ib_b_rad_s;
                 let before = state.as_ref().clone();
                 // A fix is judged before its update (see recovery::fix_disagreement).
-                let fix_diverged = match &p.measurement {
-                    Measurement::Fix(f) if report => {
-                        let d =
-                            recovery::fix_disagreement(&before, f, &self.adaptation, &self.config);
-                        Some(self.monitor.check(t, Some(&d)))
+                let (fix_diverged, hold) = match &p.measurement {
+                    Measurement::Fix(f) => {
+                        let diverged = report.then(|| {
+                            let d = recovery::fix_disagreement(
+                                &before,
+                                f,
+                                &self.adaptation,
+                                &self.config,
+                            );
+                            self.monitor.check(t, Some(&d))
+                        });
+                        (diverged, recovery::fix_hold(t, &self.monitor, &self.config))
                     }
-                    _ => None,
-                };
-                let hold = match &p.measurement {
-                    Measurement::Fix(_) => recovery::fix_hold(t, &self.monitor, &self.config),
-                    _ => None,
+                    _ => (None, None),
                 };
                 let adaptation = &mut self.adaptation;
                 let result = match &p.measurement {
