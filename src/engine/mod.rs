@@ -86,7 +86,7 @@ use crate::gnss::GnssEpoch;
 use crate::ins::ImuSample;
 
 use constraints::Constraints;
-use dispute::Hold;
+pub use dispute::Hold;
 use divergence::DivergenceMonitor;
 use heading_bank::HeadingBank;
 use imu_screen::{ImuScreen, Screened};
@@ -357,6 +357,12 @@ impl Engine {
     /// wrong, and the published covariance is widened by it.
     pub fn gnss_dispute_offset_enu_m(&self) -> Option<Vector3<f64>> {
         self.monitor.dispute_offset_enu_m()
+    }
+
+    /// How the fixes of the current dispute are held back now, loosely coupled with
+    /// `loose.leap_hold_s` ([`dispute`]); None while they are taken as they are.
+    pub fn fix_hold(&self) -> Option<Hold> {
+        recovery::fix_hold(self.last_imu_t_s()?, &self.monitor, &self.config)
     }
 
     /// The heading hypotheses of a split of the running filter (see [`heading_bank`]), 0

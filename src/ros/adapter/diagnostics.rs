@@ -1,7 +1,7 @@
 //! The adapter's /diagnostics report.
 
 use crate::config::Config;
-use crate::engine::FilterState;
+use crate::engine::{FilterState, Hold};
 use crate::ins::error_state::{ACC_SCALE, GYRO_SCALE, WHEEL_SCALE};
 use crate::ros::msg::{DiagnosticArray, DiagnosticStatus, Header, KeyValue, Time};
 
@@ -18,8 +18,9 @@ impl RosAdapter {
     /// from a divergence until the filter runs again, WARN while initializing, while the
     /// heading is split into hypotheses (its σ beyond the filter's linear range), while
     /// GNSS and filter are in a dispute (`gnss_dispute_m`: the GNSS leapt from the filter
-    /// without the IMU's support, and the published covariance is widened by the offset)
-    /// or while a second frame sends on `imu`.
+    /// without the IMU's support, and the published covariance is widened by the offset;
+    /// the message says whether the receiver's fixes are held back by the leap) or while a
+    /// second frame sends on `imu`.
     pub fn diagnostics(&self, node_name: &str, stamp: Time) -> DiagnosticArray {
         let hypotheses = self.engine.heading_hypotheses();
         let phase = match (self.engine.init_phase(), hypotheses) {
@@ -107,10 +108,19 @@ impl RosAdapter {
                 } else if let Some(conflict) = self.imu_frame_conflict() {
                     (DiagnosticStatus::WARN, conflict)
                 } else if let Some(dispute_m) = dispute_m {
+                    let held = match self.engine.fix_hold() {
+                        None => "",
+                        Some(Hold::LeftOut { .. }) => {
+                            "; the fixes are left out until the leap is confirmed"
+                        }
+                        Some(Hold::MovedBack { .. }) => {
+                            "; the fixes are held back: moved back by the leap, their covariance grown by its uncertainty"
+                        }
+                    };
                     (
                         DiagnosticStatus::WARN,
                         format!(
-                            "{phase}; GNSS leapt {dispute_m:.1} m from the filter without the IMU's support: one of them is wrong, position covariance widened by it"
+                            "{phase}; GNSS leapt {dispute_m:.1} m from the filter without the IMU's support: one of them is wrong, position covariance widened by it{held}"
                         ),
                     )
                 } else if hypotheses > 0 {

@@ -830,14 +830,15 @@ fn a_divergence_is_an_error_on_diagnostics_until_the_filter_runs_again() {
 }
 
 /// Fixes that leap 60 m up without the IMU's support (no outage before, the filter at
-/// rest): a dispute, WARN with the offset while it lasts, and no reset; OK again once the
-/// fixes are back.
+/// rest): a dispute, WARN with the offset while it lasts, its message saying when the
+/// fixes are held back by the leap (loosely coupled, out of steady fixes), and no reset;
+/// OK again once the fixes are back.
 #[test]
 fn a_gnss_leap_is_a_warning_on_diagnostics_while_disputed() {
     use crate::sim::SimEvent;
     let mut adapter = loose_adapter(OutputFrames::default());
     let leap = 30.5..40.0;
-    let mut warnings = 0;
+    let (mut warnings, mut held) = (0, 0);
     for_each_static_event(60.0, |event, stamp| {
         match event {
             SimEvent::Imu(s) => {
@@ -860,10 +861,18 @@ fn a_gnss_leap_is_a_warning_on_diagnostics_while_disputed() {
                 .parse()
                 .unwrap();
             assert!((40.0..70.0).contains(&dispute_m), "{dispute_m} m");
+            let says_held = message.contains("held back") || message.contains("left out");
+            assert_eq!(
+                says_held,
+                adapter.engine().fix_hold().is_some(),
+                "{message}"
+            );
+            held += usize::from(says_held);
             warnings += 1;
         }
     });
     assert!(warnings > 0, "no dispute");
+    assert!(held > 0, "the leap out of steady fixes was not held back");
     assert_eq!(adapter.engine().divergence_resets(), 0);
     assert_eq!(
         diagnostic(&adapter, "gnss_dispute_m").as_deref(),
