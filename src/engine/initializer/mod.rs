@@ -278,7 +278,7 @@ impl Default for Initializer {
 /// class's σ has just failed to cover it, so the restart allows an order of magnitude
 /// more, which the GNSS then narrows within tens of seconds of driving. Measured in
 /// tests/divergence_monitor.rs: after a consumer-MEMS gyro's biases jump to ten times
-/// their value (0.6–1.1 °/s) the worst NEES of the restarted filter is 16–20 against a 3σ
+/// their value (0.6–1.1 °/s) the worst NEES of the restarted filter is 14–20 against a 3σ
 /// bound of 25.3 (tightly coupled, ekf and iarf); restarted from the kept attitude and
 /// bias with the class's σ it reached 1,009.
 pub const DIVERGED_GYRO_BIAS_SIGMA_FACTOR: f64 = 10.0;

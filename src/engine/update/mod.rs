@@ -10,7 +10,8 @@
 //! 2. the innovation gate (scalar measurements), or the deweighting of a joint
 //!    measurement's outlying blocks;
 //! 3. the update of the variant's base filter and scheme ([`crate::filter::robust_update`])
-//!    and the feedback of its correction;
+//!    and the feedback of its correction (the level accelerometer biases kept as consider
+//!    states while the heading is beyond the linear range: `consider.rs`);
 //! 4. the report's common fields, and the process-noise scaling learns from the innovation;
 //! 5. the noise strategy learns from the corrected state's predictions or residuals.
 //!
@@ -37,6 +38,7 @@
 
 mod baseline_heading;
 mod carrier_phase_deltas;
+mod consider;
 mod fix;
 mod gate;
 mod model;
@@ -433,7 +435,8 @@ impl<M: MeasurementModel> Step<'_, M> {
             r,
             model: &predictions,
         };
-        let correction = self.adaptation.update.update(&state.p, &set)?;
+        let mut correction = self.adaptation.update.update(&state.p, &set)?;
+        consider::keep_level_accel_biases(&state.p, &mut correction.dx, &mut correction.p);
         let h = set.h;
         state.p = correction.p;
         state.apply_correction(&correction.dx);
