@@ -5,10 +5,9 @@
 //! (params/imu_consumer_mems.yaml) and `constraints.platform: car`, must stay within the
 //! issue's bounds: 3D RMSE below 2.7 m (KF-GINS's figure on such a drive), the largest 3D
 //! error below 30 m wherever a fix came within the last 30 s, no non-finite solution.
-//! On seed 1, and loosely coupled on seed 2 too, whose street canyon's fixes leap 46 m at
-//! once; the other seeds miss them (docs/results.md): seed 3 by the drift of its
-//! outages, and seed 4 keeps two checks, that its foliage resets no sound filter and that
-//! its canyon pulls no tightly-coupled one off.
+//! Checked on seed 1, tightly coupled on seeds 3 and 4, loosely coupled on seeds 2 and 4
+//! (seed 2 tightly coupled meets them too, 1.2–1.7 m by hand); seed 3 loosely coupled
+//! misses them by the drift of its outages (2.2–3.8 m, docs/results.md).
 //!
 //! Before `loose.fix_outlier_sigma` akf_all reached 8.6 m RMSE here (it took the canyon's
 //! outliers nearly whole) and, without the platform's constraint, the divergence monitor
@@ -117,42 +116,21 @@ fn compare_in_a_car(
 /// weighs them with. The monitor used to reset the sound filter there; the start in
 /// motion took its heading from those fixes and the ekf ran off by kilometres (3D RMSE
 /// 72.7 m, mean NEES 5737, docs/results.md). Then 7.6 m, most of it the street canyon's
-/// biased fixes, which it followed; since they are held back by their leap, 2.4 m.
+/// biased fixes, which it followed; held back by their leap, 2.2–2.6 m, and with the
+/// preset's accelerometer drift at a data sheet's rate 1.8–2.2 m.
 #[test]
-fn the_foliages_consistent_fixes_reset_no_sound_filter_on_seed_4() {
-    let (_dir, bag) = hour_bag(4);
-    for (row, _) in compare_in_a_car(&bag, &LOOSE_FILES, &[FilterVariant::Ekf]) {
-        println!("{:<13} 3D RMSE {:6.3} m", row.filter, row.pos_rmse_3d_m);
-        assert!(
-            row.pos_rmse_3d_m < 10.0,
-            "{}: {:.3} m",
-            row.filter,
-            row.pos_rmse_3d_m
-        );
-    }
+fn every_variant_loosely_coupled_meets_the_hours_bounds_on_seed_4() {
+    assert_the_hours_bounds(4, &LOOSE_FILES, &LOOSE_VARIANTS);
 }
 
 /// Seed 4's street canyon (2000–2150 s) leaves five satellites or fewer, too few for the
 /// error-correlation judge's parity fit; one of them, NLOS 10–16 m off, passed the gate
 /// and pulled the tightly-coupled ekf 20–32 m off at a σ of 2 m (3D RMSE 5.60 m, mean
-/// NEES 88, docs/results.md). Judged by its innovations it is deweighted: 1.61 m, 2.6.
-/// The bound is the 2.7 m, which seed 1 meets too.
+/// NEES 88, docs/results.md). Judged by its innovations it is deweighted: every variant
+/// 1.4–1.8 m.
 #[test]
-fn seed_4s_canyon_pulls_no_tightly_coupled_filter_off() {
-    let (_dir, bag) = hour_bag(4);
-    let files = ["params/defaults.yaml", "params/imu_consumer_mems.yaml"];
-    for (row, _) in compare_in_a_car(&bag, &files, &[FilterVariant::Ekf]) {
-        println!(
-            "{:<13} 3D RMSE {:6.3} m, mean NEES {:.2}",
-            row.filter, row.pos_rmse_3d_m, row.nees_mean
-        );
-        assert!(
-            row.pos_rmse_3d_m < MAX_RMSE_3D_M,
-            "{}: {:.3} m",
-            row.filter,
-            row.pos_rmse_3d_m
-        );
-    }
+fn every_variant_tightly_coupled_meets_the_hours_bounds_on_seed_4() {
+    assert_the_hours_bounds(4, &TIGHT_FILES, &all_variants());
 }
 
 /// The loosely-coupled variants of the paper that are weighed in the hour.
@@ -187,10 +165,20 @@ fn every_variant_loosely_coupled_meets_the_hours_bounds_on_seed_2() {
 
 #[test]
 fn every_variant_tightly_coupled_meets_the_hours_bounds() {
-    let variants: Vec<FilterVariant> = VARIANTS.iter().map(|spec| spec.variant).collect();
-    assert_the_hours_bounds(
-        1,
-        &["params/defaults.yaml", "params/imu_consumer_mems.yaml"],
-        &variants,
-    );
+    assert_the_hours_bounds(1, &TIGHT_FILES, &all_variants());
+}
+
+/// Seed 3's outages drift the most: a pitch that wandered with the accelerometer bias
+/// made a "virtual slope" (59 m after the 60 s outage loosely coupled). With the preset's
+/// drift at a data sheet's rate (100 h correlation time, not 10 h) every variant
+/// tightly coupled is 1.9–2.2 m, where it was 2.3–2.7 m (docs/results.md).
+#[test]
+fn every_variant_tightly_coupled_meets_the_hours_bounds_on_seed_3() {
+    assert_the_hours_bounds(3, &TIGHT_FILES, &all_variants());
+}
+
+const TIGHT_FILES: [&str; 2] = ["params/defaults.yaml", "params/imu_consumer_mems.yaml"];
+
+fn all_variants() -> Vec<FilterVariant> {
+    VARIANTS.iter().map(|spec| spec.variant).collect()
 }
