@@ -117,8 +117,8 @@ impl Dispute {
 
     /// Takes the dispute's next epoch `d`, which disagrees; `leapt`: its offset leapt from
     /// the epoch before's (beyond 5σ); `fixes_leapt`: as a leap of the fixes (beyond the
-    /// covariance the update weighed them with, and not the filter's: its velocity
-    /// agrees with the GNSS's).
+    /// covariance the update weighed them with, and not the filter's: its velocity error,
+    /// if any, cannot have carried it there).
     pub fn next(&mut self, d: &Disagreement, leapt: bool, fixes_leapt: bool) {
         if !self.holding() {
             return;
