@@ -6,8 +6,9 @@
 //! issue's bounds: 3D RMSE below 2.7 m (KF-GINS's figure on such a drive), the largest 3D
 //! error below 30 m wherever a fix came within the last 30 s, no non-finite solution.
 //! Checked on seed 1, tightly coupled on seeds 3 and 4, loosely coupled on seeds 2 and 4
-//! (seed 2 tightly coupled meets them too, 1.2–1.7 m by hand); seed 3 loosely coupled
-//! misses them by the drift of its outages (2.2–3.8 m, docs/results.md).
+//! and on seed 2 with the receiver's velocities (seed 2 tightly coupled meets them too,
+//! 1.2–1.7 m by hand); seed 3 loosely coupled misses them by the drift of its outages
+//! (2.2–3.8 m, docs/results.md).
 //!
 //! Before `loose.fix_outlier_sigma` akf_all reached 8.6 m RMSE here (it took the canyon's
 //! outliers nearly whole) and, without the platform's constraint, the divergence monitor

@@ -15,15 +15,16 @@
 //! Choice: while the heading 1-sigma exceeds [`BANK_ABOVE_RAD`] (where the heading bank
 //! also deems the linearization poor), the body x and y accelerometer biases are consider
 //! states (Schmidt–Kalman): the update neither corrects them nor narrows their variance;
-//! their uncertainty still flows into the other states through the propagation. No measurement model has the
-//! accelerometer biases in its rows, and with H zero in their columns the Schmidt update
-//! equals the optimal one (EKF, cubature) except for those two parts: the correction's
-//! bias entries are zeroed and their covariance block restored to the prior's. With the
-//! IARF schemes' adaptive factor the gain is not the optimal one for the prior, and the
-//! cross-covariances kept are the full update's, an approximation; the block is restored
-//! only where what the update took from it is positive semi-definite (always so for the
-//! optimal gain), which keeps the posterior so. The vertical bias is left to the update:
-//! for a level vehicle it maps into the vertical, whatever the heading.
+//! their uncertainty still flows into the other states through the propagation. No
+//! measurement model has the accelerometer biases in its rows, and with H zero in their
+//! columns the Schmidt update equals the optimal one (EKF, cubature) except for those two
+//! parts: the correction's bias entries are zeroed and their covariance block restored to
+//! the prior's. With the IARF schemes' adaptive factor the gain is not the optimal one for
+//! the prior, and the cross-covariances kept are the full update's, an approximation; the
+//! block is restored only where what the update took from it is positive semi-definite
+//! (always so for the optimal gain), which keeps the posterior so. The vertical bias is
+//! left to the update: for a level vehicle it maps into the vertical, whatever the
+//! heading.
 
 use crate::ins::error_state::{StateMatrix, StateVector, ACC_BIAS, PHI};
 
