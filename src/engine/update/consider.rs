@@ -131,6 +131,27 @@ mod tests {
         assert!(p[(ACC_BIAS + 2, ACC_BIAS + 2)] < prior[(ACC_BIAS + 2, ACC_BIAS + 2)]);
     }
 
+    /// An adaptive factor's update (the IARF schemes': the prior inflated by 1/α before
+    /// the gain) can leave the level block larger than the prior's: what it took is not
+    /// positive semi-definite, so the block is left as the update gave it, and the
+    /// posterior stays positive semi-definite; the biases are still not corrected.
+    #[test]
+    fn a_block_the_update_grew_is_left_as_it_gave_it() {
+        let (prior, h, r, y) = problem(2.0 * BANK_ABOVE_RAD);
+        let inflated = DMatrix::from_column_slice(N, N, prior.as_slice()) * 4.0;
+        let full = ekf::update(&inflated, &h, &y, &r, true).unwrap();
+        let [a, b] = LEVEL_ACCEL_BIASES;
+        assert!(full.p[(a, a)] > prior[(a, a)], "the update grew the block");
+        let mut dx = StateVector::from_column_slice(full.dx.as_slice());
+        let mut p = StateMatrix::from_column_slice(full.p.as_slice());
+        keep_level_accel_biases(&prior, &mut dx, &mut p);
+        assert_eq!((dx[a], dx[b]), (0.0, 0.0));
+        assert!(dx[ACC_BIAS + 2].abs() > 1e-6);
+        assert_eq!(p.as_slice(), full.p.as_slice());
+        let smallest = p.symmetric_eigenvalues().min();
+        assert!(smallest > -1e-9, "smallest eigenvalue {smallest}");
+    }
+
     /// Within the linear range the full update stands.
     #[test]
     fn within_the_linear_range_the_full_update_stands() {
