@@ -129,10 +129,14 @@ impl MeasurementModel for FixMeasurement<'_> {
         let m = predicted.len();
         let mut rows = geo.position_rows().to_vec();
         let mut r = DMatrix::zeros(m, m);
-        let held = self.hold_covariance_enu_m2.unwrap_or_else(Matrix3::zeros);
         r.view_mut((0, 0), (3, 3))
-            .copy_from(&(position_covariance(self.fix, self.config) + held));
-        report.fix_held_back = self.hold_covariance_enu_m2.is_some();
+            .copy_from(&position_covariance(self.fix, self.config));
+        let beyond_claim = self.hold_covariance_enu_m2.map(|held| {
+            let mut beyond = DMatrix::zeros(m, m);
+            beyond.view_mut((0, 0), (3, 3)).copy_from(&held);
+            beyond
+        });
+        report.fix_held_back = beyond_claim.is_some();
         if self.fix.velocity_enu_mps.is_some() {
             rows.extend(geo.velocity_rows());
             r.view_mut((3, 3), (3, 3))
@@ -145,6 +149,7 @@ impl MeasurementModel for FixMeasurement<'_> {
             predicted,
             noise: NominalNoise::JointBlocks {
                 r,
+                beyond_claim,
                 block_lengths,
                 outlier_sigma: outlier_sigma(self.config),
             },

@@ -85,7 +85,12 @@ pub enum NominalNoise {
     /// Mahalanobis distance √(yᵀS⁻¹y) under its innovation covariance exceeds
     /// `outlier_sigma` is deweighted (0 = off; see `Step::deweight_outlying_blocks`).
     JointBlocks {
+        /// The covariance the measurement claims (a receiver's).
         r: DMatrix<f64>,
+        /// What the rows are known to err by beyond the claim (a held-back fix's
+        /// offset, see `engine::dispute`): added to R after the claim is judged and
+        /// adapted, and charged, like the filter's H P Hᵀ, not to the claim.
+        beyond_claim: Option<DMatrix<f64>>,
         block_lengths: Vec<usize>,
         outlier_sigma: f64,
     },

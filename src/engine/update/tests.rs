@@ -2,7 +2,7 @@
 //! weights, through every base and scheme; and the rows of H of the motion constraints
 //! against differences of their predictions.
 
-use nalgebra::{DVector, UnitQuaternion, Vector3};
+use nalgebra::{DVector, Matrix3, UnitQuaternion, Vector3};
 
 use crate::config::{Config, Coupling, FilterVariant};
 use crate::earth;
@@ -262,4 +262,44 @@ fn a_fix_far_beyond_its_covariance_is_deweighted() {
     assert!(deweighted_m.abs() < 0.2 && flagged, "{deweighted_m}");
     let (near_m, flagged) = moved_up_m(2.0, 5.0);
     assert_eq!((near_m, flagged), (moved_up_m(2.0, 0.0).0, false));
+}
+
+/// The fix judge goes on learning the claim while the fixes are held back by a leap: ten
+/// held fixes 7 m off their claimed 1 m, whose hold allows 2 m more, leave the next fix
+/// that is taken as it is with its claim scaled to what made the held ones typical, the
+/// claim's share (about 16), not the hold's and the claim's together (about 4, which left
+/// a misclaiming receiver's fixes 2σ-confident once the hold ended).
+#[test]
+fn the_fix_judge_learns_the_claim_of_held_fixes() {
+    let mut config = Config::default();
+    config.filter.coupling = Coupling::Loose;
+    config.loose.use_fix_covariance = false;
+    config.loose.fix_sigma_horizontal_m = 1.0;
+    config.loose.fix_sigma_vertical_m = 1.0;
+    let mut adaptation = Adaptation::new(&config);
+    let mut state = moving_state(1e-4);
+    let rad2 = (1.0 / earth::SEMI_MAJOR_AXIS_M).powi(2);
+    for (i, var) in [rad2, rad2, 0.01].into_iter().enumerate() {
+        state.p[(DP + i, DP + i)] = var * 0.01;
+    }
+    let mut position = state.nav.p;
+    position.height_m += 7.0;
+    let fix = GnssFix {
+        t_s: 0.0,
+        position,
+        position_covariance_enu_m2: None,
+        velocity_enu_mps: None,
+        velocity_covariance_enu_m2_s2: None,
+    };
+    let rate = Vector3::zeros();
+    let hold = Matrix3::identity() * 4.0;
+    for _ in 0..10 {
+        let mut model =
+            FixMeasurement::new(&fix, &rate, &config, &state).held_back(&Vector3::zeros(), &hold);
+        apply(&mut state, &mut model, &mut adaptation, true).unwrap();
+    }
+    let mut model = FixMeasurement::new(&fix, &rate, &config, &state);
+    let report = apply(&mut state, &mut model, &mut adaptation, true).unwrap();
+    let scale = report.fix_scales[0];
+    assert!((12.0..20.0).contains(&scale), "claim scaled by {scale}");
 }
