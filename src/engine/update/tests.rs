@@ -224,6 +224,29 @@ fn zero_rate_rows_match_differences_but_the_earth_rates_attitude_part() {
     }
 }
 
+/// A moving state whose position is known to `horizontal_m2` and `up_m2`, and a fix
+/// without a covariance or a velocity `up_m` above it.
+fn fix_above_state(horizontal_m2: f64, up_m2: f64, up_m: f64) -> (FilterState, GnssFix) {
+    let mut state = moving_state(1e-4);
+    let rad2 = (1.0 / earth::SEMI_MAJOR_AXIS_M).powi(2);
+    for (i, var) in [horizontal_m2 * rad2, horizontal_m2 * rad2, up_m2]
+        .into_iter()
+        .enumerate()
+    {
+        state.p[(DP + i, DP + i)] = var;
+    }
+    let mut position = state.nav.p;
+    position.height_m += up_m;
+    let fix = GnssFix {
+        t_s: 0.0,
+        position,
+        position_covariance_enu_m2: None,
+        velocity_enu_mps: None,
+        velocity_covariance_enu_m2_s2: None,
+    };
+    (state, fix)
+}
+
 /// A fix 300 m above a state that knows its height to 1 m (the configured σ 3 m) is an
 /// outlier (95σ): deweighted, it moves the height by centimetres instead of the 30 m it
 /// moved before `loose.fix_outlier_sigma` (with it off, as the IARF paper's filters), and
@@ -236,21 +259,8 @@ fn a_fix_far_beyond_its_covariance_is_deweighted() {
         config.loose.use_fix_covariance = false;
         config.loose.fix_outlier_sigma = outlier_sigma;
         let mut adaptation = Adaptation::new(&config);
-        let mut state = moving_state(1e-4);
-        let rad2 = (1.0 / earth::SEMI_MAJOR_AXIS_M).powi(2);
-        for (i, var) in [rad2, rad2, 1.0].into_iter().enumerate() {
-            state.p[(DP + i, DP + i)] = var;
-        }
+        let (mut state, fix) = fix_above_state(1.0, 1.0, offset_up_m);
         let before_m = state.nav.p.height_m;
-        let mut position = state.nav.p;
-        position.height_m += offset_up_m;
-        let fix = GnssFix {
-            t_s: 0.0,
-            position,
-            position_covariance_enu_m2: None,
-            velocity_enu_mps: None,
-            velocity_covariance_enu_m2_s2: None,
-        };
         let rate = Vector3::zeros();
         let mut model = FixMeasurement::new(&fix, &rate, &config, &state);
         let report = apply(&mut state, &mut model, &mut adaptation, true).unwrap();
@@ -267,8 +277,8 @@ fn a_fix_far_beyond_its_covariance_is_deweighted() {
 /// The fix judge goes on learning the claim while the fixes are held back by a leap: ten
 /// held fixes 7 m off their claimed 1 m, whose hold allows 2 m more, leave the next fix
 /// that is taken as it is with its claim scaled to what made the held ones typical, the
-/// claim's share (about 16), not the hold's and the claim's together (about 4, which left
-/// a misclaiming receiver's fixes 2σ-confident once the hold ended).
+/// claim's share (about 16), not the hold's and the claim's together (4.1 with the hold
+/// charged to the claim: the next fix, 7 m off, then weighed as 2 m).
 #[test]
 fn the_fix_judge_learns_the_claim_of_held_fixes() {
     let mut config = Config::default();
@@ -277,20 +287,7 @@ fn the_fix_judge_learns_the_claim_of_held_fixes() {
     config.loose.fix_sigma_horizontal_m = 1.0;
     config.loose.fix_sigma_vertical_m = 1.0;
     let mut adaptation = Adaptation::new(&config);
-    let mut state = moving_state(1e-4);
-    let rad2 = (1.0 / earth::SEMI_MAJOR_AXIS_M).powi(2);
-    for (i, var) in [rad2, rad2, 0.01].into_iter().enumerate() {
-        state.p[(DP + i, DP + i)] = var * 0.01;
-    }
-    let mut position = state.nav.p;
-    position.height_m += 7.0;
-    let fix = GnssFix {
-        t_s: 0.0,
-        position,
-        position_covariance_enu_m2: None,
-        velocity_enu_mps: None,
-        velocity_covariance_enu_m2_s2: None,
-    };
+    let (mut state, fix) = fix_above_state(0.01, 1e-4, 7.0);
     let rate = Vector3::zeros();
     let hold = Matrix3::identity() * 4.0;
     for _ in 0..10 {
