@@ -261,7 +261,8 @@ fn heading_split_imu_step(c: &mut Criterion) {
     let noise = process_noise(&config);
     let mut running = running_state(Llh::from_degrees(39.1, 117.2, 20.0));
     running.p[(PHI + 2, PHI + 2)] = 20f64.to_radians().powi(2);
-    let start = HeadingBank::split(&running, &config).expect("a split");
+    let judges = Adaptation::new(&config).fix;
+    let start = HeadingBank::split(&running, &config, &judges).expect("a split");
     assert_eq!(start.len(), 13);
     c.bench_function("heading_split_imu_step_13_hypotheses", |b| {
         let mut bank = start.clone();

@@ -9,7 +9,8 @@
 //! each with half the spacing as its heading 1-sigma, where the filter is linear, and
 //! each weighted by the start's heading prior at its offset. Every
 //! GNSS measurement updates each hypothesis (plain EKF, no innovation gate, so that every
-//! hypothesis is scored on the same measurements) and adds its log-likelihood
+//! hypothesis is scored on the same measurements; a receiver's fixes weighed with the
+//! running filter's fix judges, see [`HeadingBank::around`]) and adds its log-likelihood
 //! −½(νᵀS⁻¹ν + ln det S). Hypotheses whose likelihood falls below [`PRUNE_RATIO`] of the
 //! best are dropped; the filter starts from the best one once it is alone, or after
 //! [`MIN_UPDATES`] updates once it holds [`RESOLVED_WEIGHT`] of the weight or the
@@ -30,9 +31,10 @@
 //! Choice: a split is a Gaussian-sum filter over the heading: each hypothesis is the
 //! running state conditioned on its heading offset (the states correlated with the heading,
 //! e.g. the vertical gyro bias, shift with it, and their variance narrows by the heading's
-//! share), so the sum keeps the running filter's mean and covariance. The hypotheses drift
-//! together (they share the bias estimate), and the one nearest the truth stays within the
-//! spacing of it, where its linearization holds. Unlike the start, a split publishes the
+//! share), so the sum keeps the running filter's mean and covariance. Each hypothesis
+//! carries the vertical gyro bias its offset implies (eleven hypotheses after a restart in
+//! foliage spanned +2.5 to −5.2 °/s), and the one nearest the truth, within the spacing of
+//! it, is where the linearization holds. Unlike the start, a split publishes the
 //! sum's moment-matched state ([`HeadingBank::published`]: weighted mean, and the weighted
 //! covariances plus spreads). It becomes one filter again once that state's heading
 //! 1-sigma is within half the spacing (no wider than one hypothesis at the split; at 10°
@@ -54,6 +56,7 @@ use crate::ins::ImuSample;
 
 use super::adaptation::Adaptation;
 use super::filter_state::{interpolate, FilterState};
+use super::fix_consistency::FixConsistency;
 use super::output::EpochReport;
 use crate::ins::mechanization::wrap_pi;
 
@@ -99,8 +102,14 @@ pub struct HeadingBank {
 }
 
 impl HeadingBank {
-    /// The bank around `initial`, whose heading has the 1-sigma `heading_sigma_rad`.
-    pub fn new(initial: &FilterState, heading_sigma_rad: f64, config: &Config) -> Self {
+    /// The bank around `initial`, whose heading has the 1-sigma `heading_sigma_rad`;
+    /// `fix_judges` are the running filter's (see [`HeadingBank::around`]).
+    pub fn new(
+        initial: &FilterState,
+        heading_sigma_rad: f64,
+        config: &Config,
+        fix_judges: &[FixConsistency; 2],
+    ) -> Self {
         let half_span = (3.0 * heading_sigma_rad).min(std::f64::consts::PI);
         let k = (half_span / SPACING_RAD).floor() as i64;
         Self::around(
@@ -108,6 +117,7 @@ impl HeadingBank {
             heading_sigma_rad,
             k,
             config,
+            fix_judges,
             |state, offset_rad| {
                 let turn = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), offset_rad);
                 state.nav.q_nb = turn * state.nav.q_nb;
@@ -117,8 +127,13 @@ impl HeadingBank {
     }
 
     /// The split of the running filter `running` (see the module documentation), or None
-    /// when its heading is within [`SPLIT_ABOVE_RAD`].
-    pub fn split(running: &FilterState, config: &Config) -> Option<Self> {
+    /// when its heading is within [`SPLIT_ABOVE_RAD`]; `fix_judges` are the running
+    /// filter's (see [`HeadingBank::around`]).
+    pub fn split(
+        running: &FilterState,
+        config: &Config,
+        fix_judges: &[FixConsistency; 2],
+    ) -> Option<Self> {
         let yaw = PHI + 2;
         let variance = running.p[(yaw, yaw)];
         if !variance.is_finite() || variance <= SPLIT_ABOVE_RAD.powi(2) {
@@ -138,11 +153,18 @@ impl HeadingBank {
         let half_span = (3.0 * offsets_sigma).min(std::f64::consts::PI);
         let k = ((half_span / SPACING_RAD).ceil() as i64)
             .min((std::f64::consts::PI / SPACING_RAD).round() as i64);
-        let mut bank = Self::around(running, offsets_sigma, k, config, |state, offset_rad| {
-            state.apply_correction(&(column * (offset_rad / variance)));
-            state.p -= column * column.transpose() * (narrowing / variance);
-            state.p = (state.p + state.p.transpose()) * 0.5;
-        });
+        let mut bank = Self::around(
+            running,
+            offsets_sigma,
+            k,
+            config,
+            fix_judges,
+            |state, offset_rad| {
+                state.apply_correction(&(column * (offset_rad / variance)));
+                state.p -= column * column.transpose() * (narrowing / variance);
+                state.p = (state.p + state.p.transpose()) * 0.5;
+            },
+        );
         bank.published = bank.moment_matched();
         Some(bank)
     }
@@ -150,11 +172,19 @@ impl HeadingBank {
     /// The hypotheses at the multiples −k…k of [`SPACING_RAD`] around `center` (at most the
     /// full circle), each made from it by `offset` (the state, the heading offset in rad)
     /// and weighted by the prior N(0, `heading_sigma_rad`²) at its offset.
+    ///
+    /// Choice: each hypothesis weighs the receiver's fixes with the running filter's fix
+    /// judges (`fix_judges`, loose coupling), not with fresh ones that take the claims for
+    /// the truth until their window has filled: in foliage, whose velocities are metres
+    /// per second off at a claimed 0.1 m/s, fresh judges let those velocities decide the
+    /// likelihoods, and a split resolved onto a hypothesis whose vertical gyro bias was
+    /// several °/s off (docs/results.md, "What that row was").
     fn around<F>(
         center: &FilterState,
         heading_sigma_rad: f64,
         k: i64,
         config: &Config,
+        fix_judges: &[FixConsistency; 2],
         offset: F,
     ) -> Self
     where
@@ -183,7 +213,10 @@ impl HeadingBank {
                 Hypothesis {
                     state,
                     log_likelihood: -0.5 * offset_sigmas.powi(2),
-                    adaptation: Adaptation::new(&bank_config),
+                    adaptation: Adaptation {
+                        fix: fix_judges.clone(),
+                        ..Adaptation::new(&bank_config)
+                    },
                     report: None,
                 }
             })
@@ -413,6 +446,11 @@ mod tests {
     use super::*;
     use crate::ins::error_state::GYRO_BIAS;
 
+    /// The fix judges of a fresh filter.
+    fn judges() -> [FixConsistency; 2] {
+        Adaptation::new(&Config::default()).fix
+    }
+
     /// A running state whose heading σ is `heading_sigma_deg`, correlated (0.8) with the
     /// vertical gyro bias (σ 0.5 °/s), as after a drive with an unknown vertical bias.
     fn running(heading_sigma_deg: f64) -> FilterState {
@@ -430,7 +468,7 @@ mod tests {
     #[test]
     fn a_split_keeps_the_running_filters_mean_and_covariance() {
         let before = running(20.0);
-        let bank = HeadingBank::split(&before, &Config::default()).unwrap();
+        let bank = HeadingBank::split(&before, &Config::default(), &judges()).unwrap();
         assert_eq!(
             bank.len(),
             13,
@@ -459,7 +497,7 @@ mod tests {
 
     #[test]
     fn a_heading_within_the_linear_range_does_not_split() {
-        assert!(HeadingBank::split(&running(14.0), &Config::default()).is_none());
-        assert!(HeadingBank::split(&running(16.0), &Config::default()).is_some());
+        assert!(HeadingBank::split(&running(14.0), &Config::default(), &judges()).is_none());
+        assert!(HeadingBank::split(&running(16.0), &Config::default(), &judges()).is_some());
     }
 }

@@ -428,7 +428,20 @@ impl Engine {
             None => Box::default(),
         };
         self.phase = Phase::Initializing(init);
+        // Choice: after a divergence from GNSS the fix judges keep their verdicts on the
+        // receiver's claims: a restart changes the filter, not the receiver, and the
+        // judges learn again only over their window, during which a restart in foliage
+        // took the receiver's claims (velocities metres per second off at 0.1 m/s) for
+        // the truth, and its tilt and vertical gyro bias took the rest (docs/results.md,
+        // "What that row was"). The other resets forget them: a time jump back or another
+        // IMU may be another recording, and after an IMU gap or a non-finite state keeping
+        // them was not measured.
+        let fix_judges =
+            (reason == ResetReason::DivergedFromGnss).then(|| self.adaptation.fix.clone());
         self.adaptation.reset();
+        if let Some(fix_judges) = fix_judges {
+            self.adaptation.fix = fix_judges;
+        }
         self.monitor.clear();
         self.imu.clear();
         self.history.clear();
@@ -788,7 +801,7 @@ impl Engine {
                 }
                 let moving = state.nav.v_n.xy().norm() >= self.config.init.heading_min_speed_mps;
                 if let Some(bank) = moving
-                    .then(|| HeadingBank::split(state, &self.config))
+                    .then(|| HeadingBank::split(state, &self.config, &self.adaptation.fix))
                     .flatten()
                 {
                     self.phase = Phase::Aligning(Box::new(bank));

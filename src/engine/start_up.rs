@@ -39,6 +39,7 @@ impl Engine {
                 &state,
                 initial.heading_sigma_rad,
                 &self.config,
+                &self.adaptation.fix,
             )));
             return;
         }
