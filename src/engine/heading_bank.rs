@@ -10,7 +10,7 @@
 //! each weighted by the start's heading prior at its offset. Every
 //! GNSS measurement updates each hypothesis (plain EKF, no innovation gate, so that every
 //! hypothesis is scored on the same measurements; a receiver's fixes weighed with the
-//! running filter's fix judges, see [`HeadingBank::around`]) and adds its log-likelihood
+//! running filter's fix judges, see `HeadingBank::around`) and adds its log-likelihood
 //! −½(νᵀS⁻¹ν + ln det S). Hypotheses whose likelihood falls below [`PRUNE_RATIO`] of the
 //! best are dropped; the filter starts from the best one once it is alone, or after
 //! [`MIN_UPDATES`] updates once it holds [`RESOLVED_WEIGHT`] of the weight or the
@@ -103,7 +103,7 @@ pub struct HeadingBank {
 
 impl HeadingBank {
     /// The bank around `initial`, whose heading has the 1-sigma `heading_sigma_rad`;
-    /// `fix_judges` are the running filter's (see [`HeadingBank::around`]).
+    /// `fix_judges` are the running filter's (see `HeadingBank::around`).
     pub fn new(
         initial: &FilterState,
         heading_sigma_rad: f64,
@@ -128,7 +128,7 @@ impl HeadingBank {
 
     /// The split of the running filter `running` (see the module documentation), or None
     /// when its heading is within [`SPLIT_ABOVE_RAD`]; `fix_judges` are the running
-    /// filter's (see [`HeadingBank::around`]).
+    /// filter's (see `HeadingBank::around`).
     pub fn split(
         running: &FilterState,
         config: &Config,
