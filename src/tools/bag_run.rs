@@ -55,6 +55,8 @@ pub struct BagRun {
     pub rejections: RejectionCounters,
     /// Where the start-up stood at the end of the bag (None: the filter was running).
     pub start_phase: Option<InitPhase>,
+    /// Resets by the divergence monitor (as `divergence_resets` on /diagnostics).
+    pub divergence_resets: u64,
 }
 
 /// What became of the receiver velocities of a bag (counted as the node counts them).
@@ -203,6 +205,7 @@ impl BagRunner {
             odom_tf: self.adapter.odom_tf_counts(),
             rejections: self.adapter.engine().counters().clone(),
             start_phase: self.adapter.engine().init_phase(),
+            divergence_resets: self.adapter.engine().divergence_resets(),
         })
     }
 }

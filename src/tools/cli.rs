@@ -280,7 +280,7 @@ pub fn run(command: Command) -> Result<(), String> {
                 .iter()
                 .map(|(row, report)| {
                     let summary = report.summary(scored_from(report));
-                    ComparisonRow::new(&row.filter, &summary, row.runtime_s)
+                    ComparisonRow::new(&row.filter, &summary, row.divergence_resets, row.runtime_s)
                 })
                 .collect();
             print!("{}", render(&rows, format)?);

@@ -110,7 +110,8 @@ fn run_one(
         .run(|_| Ok::<(), std::convert::Infallible>(()), progress)
         .map_err(|e| error(&e))?;
     let runtime = start.elapsed().as_secs_f64();
-    let row = ComparisonRow::new(&named.name, &run.report.summary(f64::NEG_INFINITY), runtime);
+    let summary = run.report.summary(f64::NEG_INFINITY);
+    let row = ComparisonRow::new(&named.name, &summary, run.divergence_resets, runtime);
     Ok((row, run.report))
 }
 
@@ -183,11 +184,13 @@ pub struct ComparisonRow {
     pub att_rmse_pitch_deg: f64,
     pub att_rmse_yaw_deg: f64,
     pub nees_mean: f64,
+    /// Resets by the divergence monitor over the run.
+    pub divergence_resets: u64,
     pub runtime_s: f64,
 }
 
 impl ComparisonRow {
-    pub fn new(filter: &str, s: &ErrorSummary, runtime_s: f64) -> Self {
+    pub fn new(filter: &str, s: &ErrorSummary, divergence_resets: u64, runtime_s: f64) -> Self {
         Self {
             filter: filter.to_owned(),
             pos_rmse_3d_m: s.pos_rmse_3d_m,
@@ -199,6 +202,7 @@ impl ComparisonRow {
             att_rmse_pitch_deg: s.att_rmse_pitch_deg,
             att_rmse_yaw_deg: s.att_rmse_yaw_deg,
             nees_mean: s.nees_mean,
+            divergence_resets,
             runtime_s,
         }
     }
@@ -223,7 +227,7 @@ const fn column(csv: &'static str, header: &'static str, width: usize, decimals:
 }
 
 /// The numeric columns after the filter name, in the order of [`ComparisonRow::values`].
-const COLUMNS: [Column; 10] = [
+const COLUMNS: [Column; 11] = [
     column("pos_rmse_3d_m", "pos3d_m", 8, 3),
     column("pos_rmse_e_m", "E_m", 7, 3),
     column("pos_rmse_n_m", "N_m", 7, 3),
@@ -233,6 +237,7 @@ const COLUMNS: [Column; 10] = [
     column("att_rmse_pitch_deg", "pitch_dg", 8, 4),
     column("att_rmse_yaw_deg", "yaw_deg", 8, 4),
     column("nees_mean", "NEES", 8, 2),
+    column("divergence_resets", "resets", 6, 0),
     column("runtime_s", "time_s", 8, 3),
 ];
 
@@ -241,7 +246,7 @@ const FILTER_WIDTH: usize = 14;
 
 impl ComparisonRow {
     /// The row's numbers in the order of [`COLUMNS`].
-    fn values(&self) -> [f64; 10] {
+    fn values(&self) -> [f64; 11] {
         [
             self.pos_rmse_3d_m,
             self.pos_rmse_e_m,
@@ -252,6 +257,7 @@ impl ComparisonRow {
             self.att_rmse_pitch_deg,
             self.att_rmse_yaw_deg,
             self.nees_mean,
+            self.divergence_resets as f64,
             self.runtime_s,
         ]
     }
@@ -379,6 +385,7 @@ mod tests {
             att_rmse_pitch_deg: 0.015625,
             att_rmse_yaw_deg: 0.5625,
             nees_mean: 2.5,
+            divergence_resets: 3,
             runtime_s: 3.375,
         }
     }
@@ -396,6 +403,7 @@ mod tests {
         assert_eq!(numbers, row().values());
         assert_eq!(numbers[8], 2.5, "nees_mean under its own name");
         assert_eq!(header[9], "nees_mean");
+        assert_eq!((header[10], values[10]), ("divergence_resets", "3"));
     }
 
     #[test]
@@ -405,6 +413,6 @@ mod tests {
         assert_eq!(lines.len(), 3);
         assert!(lines.iter().all(|l| l.len() == lines[0].len()), "{text}");
         assert!(lines[1].starts_with("ermakf "));
-        assert!(lines[1].ends_with("    2.50    3.375"), "{text}");
+        assert!(lines[1].ends_with("    2.50      3    3.375"), "{text}");
     }
 }
