@@ -348,6 +348,13 @@ impl HeadingBank {
         decided.then_some(collapsed.state)
     }
 
+    /// The fix judges of the best hypothesis, which learned the receiver's fixes while the
+    /// bank ran (see `HeadingBank::around`); None for an empty bank.
+    pub fn best_fix_judges(&self) -> Option<&[FixConsistency; 2]> {
+        let (_, best_index) = self.weights()?;
+        Some(&self.hypotheses[best_index].adaptation.fix)
+    }
+
     /// A split keeps its published state current.
     fn refresh_published(&mut self) {
         if self.published.is_some() {
@@ -493,6 +500,16 @@ mod tests {
                     < before.p[(GYRO_BIAS + 2, GYRO_BIAS + 2)]
             );
         }
+    }
+
+    #[test]
+    fn the_judges_handed_back_are_the_best_hypothesis() {
+        let mut bank = HeadingBank::split(&running(20.0), &Config::default(), &judges()).unwrap();
+        for (k, h) in bank.hypotheses.iter_mut().enumerate() {
+            h.log_likelihood = -((k as f64) - 3.0).powi(2);
+        }
+        let best = bank.best_fix_judges().unwrap();
+        assert!(std::ptr::eq(best, &bank.hypotheses[3].adaptation.fix));
     }
 
     #[test]

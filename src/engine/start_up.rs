@@ -148,6 +148,12 @@ impl Engine {
             out.push(Output::Epoch(epoch));
         }
         if let Some(state) = bank.resolved(t) {
+            // Choice: the filter runs on with the judges of the hypothesis it continues,
+            // which weighed every fix while the bank ran; its own stopped at the split
+            // (or, for a start, knew nothing).
+            if let Some(judges) = bank.best_fix_judges() {
+                self.adaptation.fix = judges.clone();
+            }
             self.start_running(state, true, out);
         }
     }
