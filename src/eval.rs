@@ -101,6 +101,8 @@ pub struct SolutionError {
     pub nees: f64,
     /// Degrees of freedom of `nees`.
     pub nees_dof: usize,
+    /// NEES of the position alone (3 degrees of freedom).
+    pub position_nees: f64,
 }
 
 /// Errors of `solution` against `truth` (at the same time).
@@ -145,6 +147,13 @@ pub fn solution_error(solution: &Solution, truth: &TruthSample) -> SolutionError
     let e = nalgebra::DVector::from_iterator(n, keep.iter().map(|&i| e9[i]));
     let p = nalgebra::DMatrix::from_fn(n, n, |r, c| p9[(keep[r], keep[c])]);
     let nees = p.cholesky().map_or(f64::NAN, |ch| e.dot(&ch.solve(&e)));
+    let position_nees = p9
+        .fixed_view::<3, 3>(0, 0)
+        .into_owned()
+        .cholesky()
+        .map_or(f64::NAN, |ch| {
+            position_enu_m.dot(&ch.solve(&position_enu_m))
+        });
     SolutionError {
         t_s: nav.t_s,
         position_enu_m,
@@ -152,6 +161,7 @@ pub fn solution_error(solution: &Solution, truth: &TruthSample) -> SolutionError
         attitude_rpy_rad,
         nees,
         nees_dof: n,
+        position_nees,
     }
 }
 
@@ -301,6 +311,21 @@ mod tests {
     }
 
     #[test]
+    fn the_position_nees_is_the_position_error_under_its_own_covariance() {
+        let mut state = crate::engine::FilterState::moving(1e-10);
+        state.p[(DP, DP)] = 4.0 / earth::metres_per_radian(&state.nav.p).0.powi(2);
+        state.p[(DP + 2, DP + 2)] = 1.0;
+        let solution = state.solution();
+        let mut truth = TruthSample::from(&solution.nav);
+        truth.p = earth::enu_to_llh(&Vector3::new(0.0, -3.0, 0.0), &solution.nav.p).unwrap();
+        let e = solution_error(&solution, &truth);
+        // 3 m north under a north σ of 2 m.
+        assert!((e.position_nees - 2.25).abs() < 1e-6, "{}", e.position_nees);
+        // No velocity or attitude error and no correlation: the full NEES is the same.
+        assert!((e.nees - e.position_nees).abs() < 1e-6, "{}", e.nees);
+    }
+
+    #[test]
     fn summary_of_known_errors() {
         let e = |x: f64, y: f64, z: f64| SolutionError {
             t_s: 0.0,
@@ -309,6 +334,7 @@ mod tests {
             attitude_rpy_rad: Some(Vector3::new(0.0, 0.0, 1f64.to_radians())),
             nees: 3.0,
             nees_dof: 9,
+            position_nees: 1.0,
         };
         let s = summarize(&[e(3.0, 0.0, 0.0), e(-3.0, 4.0, 0.0)]);
         assert_eq!(s.epochs, 2);
@@ -333,6 +359,7 @@ mod tests {
             attitude_rpy_rad: None,
             nees,
             nees_dof,
+            position_nees: nees,
         };
         // 3 dof: [0.216, 9.35]; 9 dof: [2.70, 19.02].
         let errors = [

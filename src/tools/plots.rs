@@ -634,6 +634,7 @@ mod tests {
             attitude_rpy_rad: None,
             nees: 1.0,
             nees_dof: 3,
+            position_nees: 1.0,
         }
     }
 

@@ -79,6 +79,7 @@ impl SppReport {
                     attitude_rpy_rad: None,
                     nees: f64::NAN,
                     nees_dof: 3,
+                    position_nees: f64::NAN,
                 };
                 by.entry(label.clone()).or_default().push(err);
                 by.entry("all".to_owned()).or_default().push(err);
