@@ -407,7 +407,8 @@ parameter_table! {
         /// innovations: once 4 of the last 10 fixes lie beyond the 95 % quantile of their
         /// χ²(3) (until at most 1 does), the next fix's covariance is scaled by the median
         /// of the factors that make each fix's innovation typical, at most 25 (receivers
-        /// claim far too little in foliage); counted (fix_position_rescaled,
+        /// claim far too little in foliage), and the published covariance is widened by
+        /// what the scale adds to the claim; counted (fix_position_rescaled,
         /// fix_velocity_rescaled). false = take the claim as it is (the IARF paper's
         /// filters).
         fix_consistency: bool = true, unit "", range ANY, at_start;

@@ -49,6 +49,9 @@
 //!   kept: the start-up aligns again, with a wide gyro bias prior. While the GNSS and the
 //!   filter disagree after a GNSS leap that the IMU does not support (a dispute), the
 //!   solutions are published with their position covariance widened by the offset.
+//!   Loosely coupled, while the fix judges (`fix_consistency`) find the receiver's
+//!   claims too small, by what they found beyond the claims (the filter follows such
+//!   errors, correlated over seconds, with typical innovations).
 
 mod adaptation;
 pub mod adaptive_noise;
@@ -342,12 +345,18 @@ impl Engine {
 
     /// The solution of the published state as published: with its position covariance
     /// widened while the divergence monitor holds a dispute (see
-    /// [`Engine::gnss_dispute_offset_enu_m`]). None before the start.
+    /// [`Engine::gnss_dispute_offset_enu_m`]) and while the fix judges find the claims too
+    /// small (see `recovery::published_solution`). None before the start.
     pub fn published_solution(&self) -> Option<Solution> {
         let state = self.state()?;
+        let fix_judges = match &self.phase {
+            Phase::Aligning(bank) => bank.best_fix_judges(),
+            _ => None,
+        };
         Some(recovery::published_solution(
             state,
             &self.monitor,
+            fix_judges.unwrap_or(&self.adaptation.fix),
             &self.config,
         ))
     }
@@ -762,8 +771,12 @@ impl Engine {
                 if let Some(published) = bank.published() {
                     let t_s = published.last_imu.t_s;
                     if output_due(self.config.output.rate_hz, &mut self.last_output_t_s, t_s) {
-                        let solution =
-                            recovery::published_solution(published, &self.monitor, &self.config);
+                        let solution = recovery::published_solution(
+                            published,
+                            &self.monitor,
+                            bank.best_fix_judges().unwrap_or(&self.adaptation.fix),
+                            &self.config,
+                        );
                         out.push(Output::Solution(Box::new(solution)));
                     }
                 }
@@ -796,7 +809,12 @@ impl Engine {
                 // published: the solutions of a start it found.
                 let t_s = state.last_imu.t_s;
                 if output_due(self.config.output.rate_hz, &mut self.last_output_t_s, t_s) {
-                    let solution = recovery::published_solution(state, &self.monitor, &self.config);
+                    let solution = recovery::published_solution(
+                        state,
+                        &self.monitor,
+                        &self.adaptation.fix,
+                        &self.config,
+                    );
                     out.push(Output::Solution(Box::new(solution)));
                 }
                 let moving = state.nav.v_n.xy().norm() >= self.config.init.heading_min_speed_mps;

@@ -53,6 +53,12 @@ impl Solution {
         block += enu_to_block * covariance_enu_m2 * enu_to_block.transpose();
     }
 
+    /// Adds `covariance_enu_m2_s2` (ENU, (m/s)²) to the velocity covariance.
+    pub fn widen_velocity_by_covariance(&mut self, covariance_enu_m2_s2: &Matrix3<f64>) {
+        let mut block = self.covariance.fixed_view_mut::<3, 3>(DV, DV);
+        block += covariance_enu_m2_s2;
+    }
+
     /// Covariance of the ENU velocity ((m/s)²).
     pub fn velocity_covariance_enu_m2_s2(&self) -> Matrix3<f64> {
         self.covariance.fixed_view::<3, 3>(DV, DV).into()

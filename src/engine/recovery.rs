@@ -8,6 +8,7 @@ use super::adaptation::Adaptation;
 use super::dispute::Hold;
 use super::divergence::{Disagreement, DivergenceMonitor, GnssVelocityEnu};
 use super::filter_state::FilterState;
+use super::fix_consistency::FixConsistency;
 use super::output::{EpochReport, SatRejection, Solution};
 use super::update::{position_covariance, sigma_model, GnssFix};
 use super::{initializer, Engine, Output, ResetReason};
@@ -91,13 +92,20 @@ pub(super) fn fix_disagreement(
 /// (a GNSS leap the IMU does not support: the GNSS or the filter is wrong, it cannot tell
 /// which), its position covariance widened by the offset's outer product; while the fixes
 /// are held back by the leap, by the covariance the held position is known to as well
-/// (the filter takes each held fix as new, but the offset that moves them back is one).
+/// (the filter takes each held fix as new, but the offset that moves them back is one);
+/// while the fix judges (`fix_judges`, the filter's) find the receiver's claims too small,
+/// its position and velocity covariances widened by what they found beyond the claims
+/// ([`FixConsistency::unclaimed_covariance`]).
 pub(super) fn published_solution(
     state: &FilterState,
     monitor: &DivergenceMonitor,
+    fix_judges: &[FixConsistency; 2],
     config: &Config,
 ) -> Solution {
     let mut solution = state.solution();
+    let [position_judge, velocity_judge] = fix_judges;
+    solution.widen_position_by_covariance(&position_judge.unclaimed_covariance());
+    solution.widen_velocity_by_covariance(&velocity_judge.unclaimed_covariance());
     if let Some(offset_enu_m) = monitor.dispute_offset_enu_m() {
         solution.widen_position_by(&offset_enu_m);
     }

@@ -389,6 +389,7 @@ impl<M: MeasurementModel> Step<'_, M> {
             }
             let claimed = r.select_rows(&indices).select_columns(&indices);
             let judged = fix_consistency::Judged::of(&rows.y, &hph, &claimed);
+            judge.note_claim(&claimed);
             let scale = judge.scale();
             scale_block(r, &indices, scale);
             if self.learn {
