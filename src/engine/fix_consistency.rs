@@ -155,8 +155,9 @@ impl FixConsistency {
     /// receiver's excess error is correlated over seconds (multipath, a reflection that
     /// stays), so the filter follows it, its innovations look typical, and averaging it
     /// gained nothing: on the consumer-MEMS hour's foliage the published position was
-    /// beyond the χ²(2) 99.9 % quantile on 16 % of the epochs (docs/results.md). What the
-    /// judge found beyond the claim is what the filter may carry whole.
+    /// beyond the χ²(3) 99.9 % quantile on 29–34 % of the epochs, widened on 0–0.5 %
+    /// (docs/results.md). What the judge found beyond the claim is what the filter may
+    /// carry whole.
     pub fn unclaimed_covariance(&self) -> Matrix3<f64> {
         match self.latest_claim {
             Some(claim) => claim * (self.scale() - 1.0),
