@@ -4,10 +4,12 @@
 //! for white noise and is over-confident (docs/results.md, "Correlated errors judged per
 //! satellite"); with it, asserted for the EKF and SRMAKF: the canyon's NEES inside its
 //! 95 % bounds on at least 90 % of the epochs (none without), the open sky's on at least
-//! 90 % (issue 11's bound) and higher by at least 0.3, the foliage's on at least 30 %
-//! (11 % before the C/N0 deficit weighed each obstructed satellite from its first epoch;
-//! 5 % without the judge), the mean NEES at most half, the 3D RMSE at most 10 % above
-//! (this seed's figures: docs/results.md), and the inflations counted.
+//! 90 % (issue 11's bound) and higher by at least 0.3, the foliage's on at least 80 %
+//! (0.965 and 0.890 since the published covariance is at least what the correlated
+//! satellites' excess gives the position; 0.438 and 0.375 before, 11 % before the C/N0
+//! deficit weighed each obstructed satellite from its first epoch, 5 % without the
+//! judge), the mean NEES at most half, the 3D RMSE at most 10 % above (this seed's
+//! figures: docs/results.md), and the inflations counted.
 
 use std::collections::BTreeMap;
 
@@ -77,7 +79,7 @@ fn judged_correlated_errors_make_the_covariance_honest_where_they_persist() {
             inside(&white, "urban_canyon")
         );
         assert!(
-            inside(&judged, "open_sky") >= 0.9 && inside(&judged, "foliage") >= 0.3,
+            inside(&judged, "open_sky") >= 0.9 && inside(&judged, "foliage") >= 0.8,
             "{name}: open sky {:.3}, foliage {:.3} inside",
             inside(&judged, "open_sky"),
             inside(&judged, "foliage")

@@ -356,7 +356,9 @@ parameter_table! {
         /// is seen, a satellite's by at least 10^(2 (Δ − 3 dB) / 10) when its C/N0 is Δ
         /// below its own recent level (SIGMA-Δ weighting of an obstructed signal). A
         /// filter that takes correlated errors (multipath under foliage, a facade's
-        /// reflection) for independent ones claims a precision it does not have. Counted
+        /// reflection) for independent ones claims a precision it does not have, and
+        /// follows them: the published covariance is at least what a correlated
+        /// satellite's excess beyond its claim gives the position. Counted
         /// (correlated_measurements). false = the variances as the variant gives them
         /// (the papers' filters).
         error_correlation: bool = true, unit "", range ANY, at_start;
@@ -407,7 +409,7 @@ parameter_table! {
         /// innovations: once 4 of the last 10 fixes lie beyond the 95 % quantile of their
         /// χ²(3) (until at most 1 does), the next fix's covariance is scaled by the median
         /// of the factors that make each fix's innovation typical, at most 25 (receivers
-        /// claim far too little in foliage), and the published covariance is widened by
+        /// claim far too little in foliage), and the published covariance is at least
         /// what the scale adds to the claim; counted (fix_position_rescaled,
         /// fix_velocity_rescaled). false = take the claim as it is (the IARF paper's
         /// filters).

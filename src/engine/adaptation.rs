@@ -4,12 +4,14 @@
 //! from its row of the variant table ([`crate::config::VARIANTS`]); this is where each
 //! column becomes its strategy object.
 
+use nalgebra::Matrix3;
+
 use crate::adaptive::adaptive_factor::{AdaptiveFactorFunction, AdaptiveFactorOptions};
 use crate::adaptive::equivalent_covariance::{EquivalentWeightFunction, EquivalentWeightOptions};
 use crate::config::{AdaptiveFactorKind, Config, EquivalentWeightKind, RobustScheme};
 use crate::filter::robust_update::{RobustUpdate, Scheme};
 
-use super::adaptive_noise::NoiseModel;
+use super::adaptive_noise::{NoiseModel, Observable};
 use super::error_correlation::ErrorCorrelation;
 use super::fix_consistency::FixConsistency;
 use super::q_scaling::QScaling;
@@ -47,6 +49,17 @@ impl Adaptation {
                 config.adaptive.max_epoch_gap_s,
             ),
         }
+    }
+
+    /// What the judges found beyond the measurements' claims, as the covariances the
+    /// published solution is widened by (ENU): the position's (m²) and the velocity's
+    /// ((m/s)²). See `FixConsistency::unclaimed_covariance` and [`super::range_excess`].
+    pub fn unclaimed_covariances(&self) -> (Matrix3<f64>, Matrix3<f64>) {
+        let ranges = |o| self.correlation.unclaimed_covariance(o);
+        (
+            self.fix[0].unclaimed_covariance() + ranges(Observable::Pseudorange),
+            self.fix[1].unclaimed_covariance() + ranges(Observable::PseudorangeRate),
+        )
     }
 
     /// Forgets everything learned (after a filter reset).

@@ -21,9 +21,10 @@
 //! from setting it. The scale is predictive (from the fixes before) and each judgement
 //! is of the claimed R, so the scale stays as long as the claim stays wrong.
 //!
-//! What the judge finds beyond the claim, (λ − 1) R, also widens the covariance the
-//! solution is published with ([`FixConsistency::unclaimed_covariance`]): the update
-//! cannot tell a correlated excess error from the filter's own, and follows it.
+//! What the judge finds beyond the claim, (λ − 1) R, is also a floor of the position (or
+//! velocity) covariance the solution is published with
+//! ([`FixConsistency::unclaimed_covariance`]): the update cannot tell a correlated excess
+//! error from the filter's own, and follows it.
 
 use std::collections::VecDeque;
 
@@ -150,12 +151,12 @@ impl FixConsistency {
     /// The covariance of the fixes' errors beyond their claim (ENU): (λ − 1) times the
     /// latest claim while the claim stands declared too small, zero otherwise.
     ///
-    /// Choice: the solution publishes its covariance widened by it. The filter weighs
+    /// Choice: the solution publishes a covariance of at least this. The filter weighs
     /// each fix as independent of the one before, at λ R, and averages them; a degraded
     /// receiver's excess error is correlated over seconds (multipath, a reflection that
     /// stays), so the filter follows it, its innovations look typical, and averaging it
     /// gained nothing: on the consumer-MEMS hour's foliage the published position was
-    /// beyond the χ²(3) 99.9 % quantile on 29–34 % of the epochs, widened on 0–0.5 %
+    /// beyond the χ²(3) 99.9 % quantile on 29–34 % of the epochs, so widened on 0–1 %
     /// (docs/results.md). What the judge found beyond the claim is what the filter may
     /// carry whole.
     pub fn unclaimed_covariance(&self) -> Matrix3<f64> {

@@ -348,11 +348,11 @@ impl HeadingBank {
         decided.then_some(collapsed.state)
     }
 
-    /// The fix judges of the best hypothesis, which learned the receiver's fixes while the
-    /// bank ran (see `HeadingBank::around`); None for an empty bank.
-    pub fn best_fix_judges(&self) -> Option<&[FixConsistency; 2]> {
+    /// The adaptation of the best hypothesis, whose fix judges learned the receiver's
+    /// fixes while the bank ran (see `HeadingBank::around`); None for an empty bank.
+    pub fn best_adaptation(&self) -> Option<&Adaptation> {
         let (_, best_index) = self.weights()?;
-        Some(&self.hypotheses[best_index].adaptation.fix)
+        Some(&self.hypotheses[best_index].adaptation)
     }
 
     /// A split keeps its published state current.
@@ -508,8 +508,8 @@ mod tests {
         for (k, h) in bank.hypotheses.iter_mut().enumerate() {
             h.log_likelihood = -((k as f64) - 3.0).powi(2);
         }
-        let best = bank.best_fix_judges().unwrap();
-        assert!(std::ptr::eq(best, &bank.hypotheses[3].adaptation.fix));
+        let best = bank.best_adaptation().unwrap();
+        assert!(std::ptr::eq(best, &bank.hypotheses[3].adaptation));
     }
 
     #[test]

@@ -49,9 +49,10 @@
 //!   kept: the start-up aligns again, with a wide gyro bias prior. While the GNSS and the
 //!   filter disagree after a GNSS leap that the IMU does not support (a dispute), the
 //!   solutions are published with their position covariance widened by the offset.
-//!   Loosely coupled, while the fix judges (`fix_consistency`) find the receiver's
-//!   claims too small, by what they found beyond the claims (the filter follows such
-//!   errors, correlated over seconds, with typical innovations).
+//!   While the noise judges find the measurements' claims too small (the fixes'
+//!   `fix_consistency`, the ranges' `error_correlation`), it is at least what they found
+//!   beyond the claims (the filter follows such errors, correlated over seconds, with
+//!   typical innovations; [`range_excess`]).
 
 mod adaptation;
 pub mod adaptive_noise;
@@ -71,6 +72,7 @@ mod initializer;
 mod output;
 mod phase_anchor;
 pub mod q_scaling;
+mod range_excess;
 mod recovery;
 mod rejection;
 mod retune;
@@ -345,18 +347,18 @@ impl Engine {
 
     /// The solution of the published state as published: with its position covariance
     /// widened while the divergence monitor holds a dispute (see
-    /// [`Engine::gnss_dispute_offset_enu_m`]) and while the fix judges find the claims too
-    /// small (see `recovery::published_solution`). None before the start.
+    /// [`Engine::gnss_dispute_offset_enu_m`]) and while the noise judges find the claims
+    /// too small (see `recovery::published_solution`). None before the start.
     pub fn published_solution(&self) -> Option<Solution> {
         let state = self.state()?;
-        let fix_judges = match &self.phase {
-            Phase::Aligning(bank) => bank.best_fix_judges(),
+        let adaptation = match &self.phase {
+            Phase::Aligning(bank) => bank.best_adaptation(),
             _ => None,
         };
         Some(recovery::published_solution(
             state,
             &self.monitor,
-            fix_judges.unwrap_or(&self.adaptation.fix),
+            adaptation.unwrap_or(&self.adaptation),
             &self.config,
         ))
     }
@@ -774,7 +776,7 @@ impl Engine {
                         let solution = recovery::published_solution(
                             published,
                             &self.monitor,
-                            bank.best_fix_judges().unwrap_or(&self.adaptation.fix),
+                            bank.best_adaptation().unwrap_or(&self.adaptation),
                             &self.config,
                         );
                         out.push(Output::Solution(Box::new(solution)));
@@ -812,7 +814,7 @@ impl Engine {
                     let solution = recovery::published_solution(
                         state,
                         &self.monitor,
-                        &self.adaptation.fix,
+                        &self.adaptation,
                         &self.config,
                     );
                     out.push(Output::Solution(Box::new(solution)));

@@ -53,6 +53,22 @@ impl Solution {
         block += enu_to_block * covariance_enu_m2 * enu_to_block.transpose();
     }
 
+    /// Widens the position covariance so that it is at least `floor_enu_m2` (ENU, m²) in
+    /// every direction (see [`shortfall`]).
+    pub fn widen_position_to_at_least(&mut self, floor_enu_m2: &Matrix3<f64>) {
+        if let Some(short) = shortfall(floor_enu_m2, &self.position_covariance_enu_m2()) {
+            self.widen_position_by_covariance(&short);
+        }
+    }
+
+    /// Widens the velocity covariance so that it is at least `floor_enu_m2_s2` (ENU,
+    /// (m/s)²) in every direction, as [`Self::widen_position_to_at_least`].
+    pub fn widen_velocity_to_at_least(&mut self, floor_enu_m2_s2: &Matrix3<f64>) {
+        if let Some(short) = shortfall(floor_enu_m2_s2, &self.velocity_covariance_enu_m2_s2()) {
+            self.widen_velocity_by_covariance(&short);
+        }
+    }
+
     /// Adds `covariance_enu_m2_s2` (ENU, (m/s)²) to the velocity covariance.
     pub fn widen_velocity_by_covariance(&mut self, covariance_enu_m2_s2: &Matrix3<f64>) {
         let mut block = self.covariance.fixed_view_mut::<3, 3>(DV, DV);
@@ -367,4 +383,62 @@ pub enum Output {
     Solution(Box<Solution>),
     Epoch(EpochReport),
     Status(StatusEvent),
+}
+
+/// What `covariance` lacks of `floor` in every direction: the positive part of the floor
+/// less the covariance. None for a zero floor, or a covariance that is not finite or has
+/// a negative eigenvalue beyond rounding: a broken covariance is left as it is, for the
+/// outputs to count and refuse, not repaired by a floor.
+fn shortfall(floor: &Matrix3<f64>, covariance: &Matrix3<f64>) -> Option<Matrix3<f64>> {
+    if floor.iter().all(|&v| v == 0.0) || !covariance.iter().all(|v| v.is_finite()) {
+        return None;
+    }
+    let eigenvalues = (0.5 * (covariance + covariance.transpose())).symmetric_eigenvalues();
+    if eigenvalues.min() < -1e-9 * eigenvalues.amax() {
+        return None;
+    }
+    Some(positive_part(&(floor - covariance)))
+}
+
+/// The positive semi-definite part of the symmetric part of `m`: its negative
+/// eigenvalues set to zero.
+fn positive_part(m: &Matrix3<f64>) -> Matrix3<f64> {
+    let mut eigen = (0.5 * (m + m.transpose())).symmetric_eigen();
+    eigen.eigenvalues.iter_mut().for_each(|v| *v = v.max(0.0));
+    eigen.recompose()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::filter_state::FilterState;
+    use super::*;
+
+    #[test]
+    fn a_floor_widens_only_the_directions_it_exceeds() {
+        let mut state = FilterState::moving(1e-12);
+        let (north, east) = earth::metres_per_radian(&state.nav.p);
+        state.p[(DP, DP)] = 4.0 / (north * north);
+        state.p[(DP + 1, DP + 1)] = 1.0 / (east * east);
+        state.p[(DP + 2, DP + 2)] = 9.0;
+        let mut solution = state.solution();
+        // East 1 → 2 m², north stays 4 m² (the floor's 3 is less), up stays 9 m².
+        solution.widen_position_to_at_least(&Matrix3::from_diagonal(&Vector3::new(2.0, 3.0, 0.0)));
+        let c = solution.position_covariance_enu_m2();
+        let expected = Matrix3::from_diagonal(&Vector3::new(2.0, 4.0, 9.0));
+        assert!((c - expected).norm() < 1e-9, "{c}");
+        solution.widen_velocity_to_at_least(&(Matrix3::identity() * 0.25));
+        let v = solution.velocity_covariance_enu_m2_s2();
+        assert!((v - Matrix3::identity() * 0.25).norm() < 1e-9, "{v}");
+    }
+
+    #[test]
+    fn a_floor_does_not_repair_a_broken_covariance() {
+        let mut state = FilterState::moving(1e-12);
+        state.p[(DP + 2, DP + 2)] = -1.0;
+        let mut solution = state.solution();
+        solution.widen_position_to_at_least(&Matrix3::zeros());
+        assert_eq!(solution.position_covariance_enu_m2()[(2, 2)], -1.0);
+        solution.widen_position_to_at_least(&(Matrix3::identity() * 4.0));
+        assert_eq!(solution.position_covariance_enu_m2()[(2, 2)], -1.0);
+    }
 }

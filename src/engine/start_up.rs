@@ -151,8 +151,8 @@ impl Engine {
             // Choice: the filter runs on with the judges of the hypothesis it continues,
             // which weighed every fix while the bank ran; its own stopped at the split
             // (or, for a start, knew nothing).
-            if let Some(judges) = bank.best_fix_judges() {
-                self.adaptation.fix = judges.clone();
+            if let Some(best) = bank.best_adaptation() {
+                self.adaptation.fix = best.fix.clone();
             }
             self.start_running(state, true, out);
         }

@@ -53,7 +53,7 @@ mod zero_velocity;
 
 use std::sync::Arc;
 
-use nalgebra::{DMatrix, DVector, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
 use crate::config::Config;
 use crate::filter::ekf::FilterError;
@@ -70,6 +70,7 @@ use super::filter_state::FilterState;
 use super::fix_consistency;
 use super::output::{EpochReport, MeasurementKind};
 use super::phase_anchor::PhaseAnchor;
+use super::range_excess;
 use gate::{gate, GateRow};
 
 pub use baseline_heading::BaselineHeading;
@@ -217,7 +218,7 @@ impl<M: MeasurementModel> Step<'_, M> {
         }
         let y = innovations(lin);
         let hph: Vec<f64> = scalars.iter().map(|s| s.hph).collect();
-        let correlated = self.judge_correlation(lin, channels, &y, &r, &hph);
+        let (correlated, sizes) = self.judge_correlation(lin, channels, &y, &r, &hph);
         self.report.correlated_measurements = correlated.iter().filter(|&&f| f > 1.0).count();
         let gate_rows: Vec<GateRow> = (0..m)
             .map(|i| GateRow {
@@ -235,6 +236,23 @@ impl<M: MeasurementModel> Step<'_, M> {
             |i, innovation, normalized| model.report_gated(report, i, innovation, normalized),
         );
         self.report.q_scale = self.adaptation.q.scale();
+        if self.learn && self.model.kind() == MeasurementKind::Pseudoranges {
+            let rows: Vec<(Observable, range_excess::ExcessRow)> = kept
+                .iter()
+                .map(|&i| {
+                    let observable = channels[i].observable;
+                    let (first, clock) = common_columns(observable);
+                    let row = &lin.rows[i];
+                    let excess = range_excess::ExcessRow {
+                        common: [row[first], row[first + 1], row[first + 2], row[clock]],
+                        weighed_variance: r[i] * correlated[i],
+                        excess_variance: (sizes[i] - 1.0) * r[i],
+                    };
+                    (observable, excess)
+                })
+                .collect();
+            self.note_range_excess(state, &rows);
+        }
         if !kept.is_empty() {
             let mut r_kept = DMatrix::zeros(kept.len(), kept.len());
             for (j, &i) in kept.iter().enumerate() {
@@ -259,10 +277,43 @@ impl<M: MeasurementModel> Step<'_, M> {
         Ok(())
     }
 
+    /// Keeps with the range judge what the excesses it found in the kept `rows` of each
+    /// observable leave the position and the velocity with ([`super::range_excess`]).
+    fn note_range_excess(
+        &mut self,
+        state: &FilterState,
+        rows: &[(Observable, range_excess::ExcessRow)],
+    ) {
+        let (north, east) = crate::earth::metres_per_radian(&state.nav.p);
+        for observable in [Observable::Pseudorange, Observable::PseudorangeRate] {
+            let rows: Vec<range_excess::ExcessRow> = rows
+                .iter()
+                .filter(|(o, _)| *o == observable)
+                .map(|(_, row)| *row)
+                .collect();
+            let covariance = range_excess::projected_excess(&rows).unwrap_or_else(Matrix3::zeros);
+            let enu = match observable {
+                // The position columns are (δL, δλ, δh): to east, north, up.
+                Observable::Pseudorange => {
+                    #[rustfmt::skip]
+                    let to_enu = Matrix3::new(
+                        0.0, east, 0.0,
+                        north, 0.0, 0.0,
+                        0.0, 0.0, 1.0,
+                    );
+                    to_enu * covariance * to_enu.transpose()
+                }
+                Observable::PseudorangeRate => covariance,
+            };
+            self.adaptation.correlation.note_unclaimed(observable, enu);
+        }
+    }
+
     /// The factor on each row's variance `r` for its channel's error correlation
-    /// ([`super::error_correlation`]), from the epochs before; then the judge takes this
-    /// epoch's innovations `y`, with the filter's share `hph` of their variance (unless
-    /// re-applied after a roll-back).
+    /// ([`super::error_correlation`]), from the epochs before, and the part of it that
+    /// says a correlated error is larger than claimed; then the judge takes this epoch's
+    /// innovations `y`, with the filter's share `hph` of their variance (unless re-applied
+    /// after a roll-back).
     fn judge_correlation(
         &mut self,
         lin: &Linearization,
@@ -270,25 +321,26 @@ impl<M: MeasurementModel> Step<'_, M> {
         y: &[f64],
         r: &[f64],
         hph: &[f64],
-    ) -> Vec<f64> {
+    ) -> (Vec<f64>, Vec<f64>) {
         let t_s = self.model.t_s();
         let judge = &mut self.adaptation.correlation;
         if !judge.is_on() {
-            return vec![1.0; channels.len()];
+            return (vec![1.0; channels.len()], vec![1.0; channels.len()]);
         }
         let factors = channels
             .iter()
             .map(|c| judge.inflation(c.sat, c.observable, t_s, c.cn0_dbhz))
+            .collect();
+        let sizes = channels
+            .iter()
+            .map(|c| judge.carried_size_factor(c.sat, c.observable, t_s, c.cn0_dbhz))
             .collect();
         if self.learn {
             let epoch: Vec<ChannelInnovation> = channels
                 .iter()
                 .enumerate()
                 .map(|(i, c)| {
-                    let (first, clock) = match c.observable {
-                        Observable::Pseudorange => (DP, CLOCK_BIAS),
-                        Observable::PseudorangeRate => (DV, CLOCK_DRIFT),
-                    };
+                    let (first, clock) = common_columns(c.observable);
                     let row = &lin.rows[i];
                     ChannelInnovation {
                         sat: c.sat,
@@ -303,7 +355,7 @@ impl<M: MeasurementModel> Step<'_, M> {
                 .collect();
             judge.push(t_s, &epoch);
         }
-        factors
+        (factors, sizes)
     }
 
     /// A measurement whose noise is one matrix: updated as a whole (its outlying blocks
@@ -581,4 +633,13 @@ impl<M: MeasurementModel> ErrorStateModel for Predictions<'_, M> {
 
 fn all_finite(values: DVector<f64>) -> Option<DVector<f64>> {
     values.iter().all(|v| v.is_finite()).then_some(values)
+}
+
+/// The first of an observable's three common columns (position or velocity) and its
+/// clock column (clock or clock drift).
+fn common_columns(observable: Observable) -> (usize, usize) {
+    match observable {
+        Observable::Pseudorange => (DP, CLOCK_BIAS),
+        Observable::PseudorangeRate => (DV, CLOCK_DRIFT),
+    }
 }
