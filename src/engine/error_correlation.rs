@@ -237,14 +237,10 @@ impl ErrorCorrelation {
         t_s: f64,
         cn0_dbhz: Option<f64>,
     ) -> f64 {
-        if !self.is_on() {
-            return 1.0;
-        }
-        let floor = self
-            .cn0
-            .floor(sat, t_s, cn0_dbhz, self.max_gap_s, self.max_inflation);
-        let (size, correlation) = self.judged(sat, observable, t_s);
-        (size * correlation).min(self.max_inflation).max(floor)
+        self.factors(sat, observable, t_s, cn0_dbhz)
+            .map_or(1.0, |(size, correlation, floor)| {
+                (size * correlation).min(self.max_inflation).max(floor)
+            })
     }
 
     /// The part of [`Self::inflation`] that says the channel's errors are larger than
@@ -264,17 +260,31 @@ impl ErrorCorrelation {
         t_s: f64,
         cn0_dbhz: Option<f64>,
     ) -> f64 {
-        if !self.is_on() {
-            return 1.0;
+        match self.factors(sat, observable, t_s, cn0_dbhz) {
+            Some((size, correlation, floor)) if correlation > 1.0 => {
+                size.min(self.max_inflation).max(floor)
+            }
+            _ => 1.0,
         }
-        let (size, correlation) = self.judged(sat, observable, t_s);
-        if correlation <= 1.0 {
-            return 1.0;
+    }
+
+    /// The channel's (variance, correlation) factors ([`Self::judged`]) and its C/N0
+    /// deficit's floor this epoch; None when off.
+    fn factors(
+        &self,
+        sat: SatId,
+        observable: Observable,
+        t_s: f64,
+        cn0_dbhz: Option<f64>,
+    ) -> Option<(f64, f64, f64)> {
+        if !self.is_on() {
+            return None;
         }
         let floor = self
             .cn0
             .floor(sat, t_s, cn0_dbhz, self.max_gap_s, self.max_inflation);
-        size.min(self.max_inflation).max(floor)
+        let (size, correlation) = self.judged(sat, observable, t_s);
+        Some((size, correlation, floor))
     }
 
     /// The factors from the residuals of the epochs before (see [`Self::inflation`]):

@@ -61,10 +61,10 @@ mod tests {
     use super::*;
 
     /// Rows of a unit-vector geometry (east, north, up, and two tilted ones, each with
-    /// the clock column 1).
-    fn geometry() -> Vec<[f64; 4]> {
+    /// the clock column 1), each weighed at `weighed` with `excess` beyond its claim.
+    fn rows(weighed: f64, excess: f64) -> Vec<ExcessRow> {
         let s = 0.5_f64.sqrt();
-        vec![
+        [
             [1.0, 0.0, 0.0, 1.0],
             [-1.0, 0.0, 0.0, 1.0],
             [0.0, 1.0, 0.0, 1.0],
@@ -72,20 +72,20 @@ mod tests {
             [s, 0.0, s, 1.0],
             [-s, 0.0, s, 1.0],
         ]
+        .into_iter()
+        .map(|common| ExcessRow {
+            common,
+            weighed_variance: weighed,
+            excess_variance: excess,
+        })
+        .collect()
     }
 
     #[test]
     fn equal_excesses_give_the_least_squares_covariance_scaled() {
         // Every row weighed at 2 m² with 6 m² beyond the claim: the excess covariance is
         // (AᵀA)⁻¹ · 2² · 6 / 2² = 6 (AᵀA)⁻¹, three times the weighed solution's 2 (AᵀA)⁻¹.
-        let rows: Vec<ExcessRow> = geometry()
-            .into_iter()
-            .map(|common| ExcessRow {
-                common,
-                weighed_variance: 2.0,
-                excess_variance: 6.0,
-            })
-            .collect();
+        let rows = rows(2.0, 6.0);
         let normal = rows.iter().fold(Matrix4::zeros(), |n, r| {
             let a = Vector4::from(r.common);
             n + a * a.transpose()
@@ -99,14 +99,7 @@ mod tests {
 
     #[test]
     fn no_excess_gives_nothing_and_too_few_rows_cannot_say() {
-        let rows: Vec<ExcessRow> = geometry()
-            .into_iter()
-            .map(|common| ExcessRow {
-                common,
-                weighed_variance: 1.0,
-                excess_variance: 0.0,
-            })
-            .collect();
+        let rows = rows(1.0, 0.0);
         assert_eq!(projected_excess(&rows), Some(Matrix3::zeros()));
         let mut three = rows[..3].to_vec();
         three[0].excess_variance = 4.0;
@@ -115,14 +108,7 @@ mod tests {
 
     #[test]
     fn one_satellites_excess_falls_along_its_line_of_sight() {
-        let mut rows: Vec<ExcessRow> = geometry()
-            .into_iter()
-            .map(|common| ExcessRow {
-                common,
-                weighed_variance: 1.0,
-                excess_variance: 0.0,
-            })
-            .collect();
+        let mut rows = rows(1.0, 0.0);
         rows[0].excess_variance = 9.0;
         let got = projected_excess(&rows).unwrap();
         assert!(got[(0, 0)] > 0.5, "east takes it: {got}");
