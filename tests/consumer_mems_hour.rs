@@ -236,7 +236,8 @@ fn every_variant_loosely_coupled_is_honest_in_the_foliage_on_seed_3() {
     for (row, report) in compare_in_a_car(&bag, &LOOSE_FILES, &LOOSE_VARIANTS) {
         let (all, position) = shares_beyond_q999(&report, "foliage");
         println!(
-            "{:<13} of the foliage's epochs {:.2} % beyond {CHI2_9_Q999}, the position {:.2} % beyond {CHI2_3_Q999}",
+            "{:<13} of the foliage's epochs {:.2} % beyond {CHI2_9_Q999}, the position \
+             {:.2} % beyond {CHI2_3_Q999}",
             row.filter,
             100.0 * all,
             100.0 * position

@@ -52,7 +52,7 @@ impl Adaptation {
     }
 
     /// What the judges found beyond the measurements' claims, as the covariances the
-    /// published solution is widened by (ENU): the position's (m²) and the velocity's
+    /// published solution is at least (ENU): the position's (m²) and the velocity's
     /// ((m/s)²). See `FixConsistency::unclaimed_covariance` and [`super::range_excess`].
     pub fn unclaimed_covariances(&self) -> (Matrix3<f64>, Matrix3<f64>) {
         let ranges = |o| self.correlation.unclaimed_covariance(o);

@@ -13,9 +13,9 @@
 //! judge's size factor (not its correlation factor: a correlated error of the claimed size
 //! is the claimed size at each epoch), counted only where the judge also finds the
 //! channel correlated in time (`ErrorCorrelation::carried_size_factor`), weighed as the
-//! update weighs the rows (1 / (R f), f the whole inflation). The least squares is that of the rows' common columns (position
-//! or velocity, and the clock), as the judge's parity fit; an epoch whose rows cannot fix
-//! them leaves nothing.
+//! update weighs the rows (1 / (R f), f the whole inflation). The least squares is that
+//! of the rows' common columns (position or velocity, and the clock), as the judge's
+//! parity fit; an epoch whose rows cannot fix them leaves nothing.
 
 use nalgebra::{Matrix3, Matrix4, Vector4};
 
