@@ -3,8 +3,9 @@
 //! a claim by up to σ × 5), loosely coupled with the
 //! default IMU. With the claim taken as given the filter's covariance is exceeded on most
 //! epochs; judged by the filter's innovations, the claim is scaled (counted) and the
-//! filter's 9-state NEES is inside its 95 % bound on most epochs. A receiver that claims
-//! what it errs is left alone.
+//! filter's 9-state NEES is inside its 95 % bound on most epochs, and the published
+//! position's floor is what the errors hold beyond the claim. A receiver that claims what
+//! it errs is left alone.
 
 use adaptive_gnss_ins::config::{Config, Coupling};
 use adaptive_gnss_ins::engine::Engine;
@@ -36,6 +37,9 @@ const SCORED_FROM_S: f64 = 120.0;
 struct Run {
     inside_share: f64,
     rescaled: u64,
+    /// σ of the published position's floor at the end (m, 3D): what the judge found
+    /// beyond the claims.
+    unclaimed_sigma_m: f64,
 }
 
 /// Plays the drive loosely coupled with the default IMU and fixes erring [`ERROR_M`]
@@ -95,6 +99,7 @@ fn run(claimed_m: f64, judged: bool) -> Run {
     Run {
         inside_share: inside as f64 / scored as f64,
         rescaled: engine.deweighted().position_rescaled,
+        unclaimed_sigma_m: engine.unclaimed_covariances().0.trace().sqrt(),
     }
 }
 
@@ -104,19 +109,27 @@ fn a_receiver_claiming_a_quarter_of_its_error_is_judged_and_the_filter_is_honest
     let judged = run(ERROR_M / 4.0, true);
     let truthful = run(ERROR_M, true);
     println!(
-        "inside the 95 % NEES bound: claim taken {:.3}, judged {:.3} ({} fixes rescaled), \
-         a truthful receiver {:.3} ({} rescaled)",
+        "inside the 95 % NEES bound: claim taken {:.3}, judged {:.3} ({} fixes rescaled, \
+         floor σ {:.2} m), a truthful receiver {:.3} ({} rescaled, floor σ {:.2} m)",
         taken.inside_share,
         judged.inside_share,
         judged.rescaled,
+        judged.unclaimed_sigma_m,
         truthful.inside_share,
-        truthful.rescaled
+        truthful.rescaled,
+        truthful.unclaimed_sigma_m
     );
     assert!(taken.inside_share < 0.5, "the test sees the misclaim");
     assert_eq!(taken.rescaled, 0);
     assert!(judged.inside_share >= 0.9, "{}", judged.inside_share);
     assert!(judged.rescaled > 100, "{}", judged.rescaled);
     assert!(truthful.inside_share >= 0.9, "{}", truthful.inside_share);
+    // The published position's floor is what the errors hold beyond the claim,
+    // √(3 (2² − 0.5²)) = 3.35 m, within a fifth; none for the truthful receiver.
+    let beyond_m = (3.0 * (ERROR_M.powi(2) - (ERROR_M / 4.0).powi(2))).sqrt();
+    let ratio = judged.unclaimed_sigma_m / beyond_m;
+    assert!((0.8..1.2).contains(&ratio), "{}", judged.unclaimed_sigma_m);
+    assert_eq!(truthful.unclaimed_sigma_m, 0.0);
 }
 
 /// The yaw errors (deg) and σ (deg) of a start on a receiver erring [`ERROR_M`] that

@@ -83,7 +83,7 @@ mod wheel_odometry;
 
 use std::collections::VecDeque;
 
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 
 use crate::config::{Config, Coupling};
 use crate::filter::process_model::{ClockNoise, ImuScaleNoise, ProcessNoise};
@@ -351,16 +351,28 @@ impl Engine {
     /// too small (see `recovery::published_solution`). None before the start.
     pub fn published_solution(&self) -> Option<Solution> {
         let state = self.state()?;
-        let adaptation = match &self.phase {
-            Phase::Aligning(bank) => bank.best_adaptation(),
-            _ => None,
-        };
         Some(recovery::published_solution(
             state,
             &self.monitor,
-            adaptation.unwrap_or(&self.adaptation),
+            self.published_adaptation(),
             &self.config,
         ))
+    }
+
+    /// What the noise judges find beyond the measurements' claims now, the floor of the
+    /// published covariances (ENU): the position's (m²) and the velocity's ((m/s)²); zero
+    /// while they find none.
+    pub fn unclaimed_covariances(&self) -> (Matrix3<f64>, Matrix3<f64>) {
+        self.published_adaptation().unclaimed_covariances()
+    }
+
+    /// The adaptation whose judges the published solution reflects: while a heading bank
+    /// runs, its best hypothesis'.
+    fn published_adaptation(&self) -> &Adaptation {
+        match &self.phase {
+            Phase::Aligning(bank) => bank.best_adaptation().unwrap_or(&self.adaptation),
+            _ => &self.adaptation,
+        }
     }
 
     /// The GNSS position less the filter's (ENU, m) while the GNSS and the filter disagree

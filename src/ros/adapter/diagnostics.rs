@@ -99,6 +99,9 @@ impl RosAdapter {
                 let trace_m2 = solution.position_covariance_enu_m2().trace();
                 let sigma_m = sigma_of_variance(trace_m2);
                 values.push(key_value("position_sigma_3d_m", format!("{sigma_m:.3}")));
+                let (floor_m2, _) = self.engine.unclaimed_covariances();
+                let floor_m = sigma_of_variance(floor_m2.trace());
+                values.push(key_value("unclaimed_sigma_3d_m", format!("{floor_m:.3}")));
                 values.extend(scale_factor_values(state, self.engine.config()));
                 if !sigma_m.is_finite() {
                     (

@@ -779,6 +779,41 @@ fn constraint_updates_are_counted_on_diagnostics() {
     assert_eq!(counts("false"), [0, 0, 0]);
 }
 
+/// A receiver that claims far less than it errs, on /diagnostics: from 20 s on the static
+/// scenario's fixes scatter by metres at their claimed sub-metre σ. Once the fix judge has
+/// declared the claim too small, `unclaimed_sigma_3d_m` holds what it found beyond the
+/// claim, and the published `position_sigma_3d_m` is at least that; before, it is 0.
+#[test]
+fn a_misclaiming_receiver_floors_the_published_sigma_on_diagnostics() {
+    use crate::sim::SimEvent;
+    let mut adapter = loose_adapter(OutputFrames::default());
+    let value = |adapter: &RosAdapter, key: &str| -> f64 {
+        diagnostic(adapter, key).unwrap().parse().unwrap()
+    };
+    let mut before = None;
+    for_each_static_event(60.0, |event, stamp| match event {
+        SimEvent::Imu(s) => {
+            adapter.on_imu(&outbound::imu(&s, stamp, "imu"));
+        }
+        SimEvent::Fix(mut f) => {
+            if f.t_s >= 20.0 {
+                let k = f.t_s;
+                let off = nalgebra::Vector3::new((1.7 * k).sin(), (2.3 * k).cos(), (0.9 * k).sin());
+                f.position = crate::earth::enu_to_llh(&(off * 3.0), &f.position).unwrap();
+            } else if f.t_s >= 19.0 && before.is_none() {
+                before = Some(value(&adapter, "unclaimed_sigma_3d_m"));
+            }
+            adapter.on_fix(&outbound::receiver_fix(&f, stamp, "gnss"));
+        }
+        _ => {}
+    });
+    assert_eq!(before, Some(0.0));
+    let floor_m = value(&adapter, "unclaimed_sigma_3d_m");
+    let sigma_m = value(&adapter, "position_sigma_3d_m");
+    assert!(floor_m > 1.0, "{floor_m}");
+    assert!(sigma_m >= floor_m - 1e-3, "{sigma_m} {floor_m}");
+}
+
 /// A divergence on /diagnostics: after a 3 s outage the receiver's fixes come back 500 m
 /// away and stay there (the monitor cannot tell which side moved; it trusts the GNSS that
 /// agrees with itself). The engine resets; until the filter runs again the level is ERROR
