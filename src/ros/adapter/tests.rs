@@ -780,9 +780,9 @@ fn constraint_updates_are_counted_on_diagnostics() {
 }
 
 /// A receiver that claims far less than it errs, on /diagnostics: from 20 s on the static
-/// scenario's fixes scatter by metres at their claimed sub-metre σ. Once the fix judge has
-/// declared the claim too small, `unclaimed_sigma_3d_m` holds what it found beyond the
-/// claim, and the published `position_sigma_3d_m` is at least that; before, it is 0.
+/// scenario's fixes scatter by up to 3 m per axis at their claimed σ. Once the fix judge
+/// has declared the claim too small, `unclaimed_sigma_3d_m` holds what it found beyond
+/// the claim, and the published `position_sigma_3d_m` is at least that; before, it is 0.
 #[test]
 fn a_misclaiming_receiver_floors_the_published_sigma_on_diagnostics() {
     use crate::sim::SimEvent;
