@@ -133,6 +133,19 @@ pub struct ChannelInnovation {
     pub common: [f64; COMMON_COLUMNS],
 }
 
+/// The judge's verdict on a channel ([`ErrorCorrelation::verdict`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Verdict {
+    /// The factor on the channel's variance: 1, or more when the channel is significantly
+    /// correlated or larger than claimed, its observable's common scale is, or its C/N0
+    /// is below its own recent level.
+    pub inflation: f64,
+    /// The part of it that says the errors are larger than claimed (the variance factor:
+    /// its own, its observable's common scale, or its C/N0 deficit's floor, at most the
+    /// inflation) where the channel is also judged correlated in time; 1 otherwise.
+    pub carried_size: f64,
+}
+
 /// The judge of every channel's error correlation.
 #[derive(Debug, Clone)]
 pub struct ErrorCorrelation {
@@ -225,69 +238,44 @@ impl ErrorCorrelation {
         self.unclaimed[observable_index(observable)]
     }
 
-    /// The factor on the variance of `sat`'s `observable` at `t_s`, from the epochs
-    /// before, and at least the floor of the satellite's C/N0 of this epoch, `cn0_dbhz`
-    /// ([`Cn0Deficit`]); 1 when off, or when neither the channel is significantly
-    /// correlated or larger than claimed, nor its observable's common scale is, nor its
-    /// C/N0 below its own recent level.
-    pub fn inflation(
+    /// The judge's verdict on `sat`'s `observable` at `t_s`, from the epochs before, with
+    /// the floor of the satellite's C/N0 of this epoch, `cn0_dbhz` ([`Cn0Deficit`]); 1 and
+    /// 1 when off.
+    pub fn verdict(
         &self,
         sat: SatId,
         observable: Observable,
         t_s: f64,
         cn0_dbhz: Option<f64>,
-    ) -> f64 {
-        self.factors(sat, observable, t_s, cn0_dbhz)
-            .map_or(1.0, |(size, correlation, floor)| {
-                (size * correlation).min(self.max_inflation).max(floor)
-            })
-    }
-
-    /// The part of [`Self::inflation`] that says the channel's errors are larger than
-    /// claimed (the variance factor: its own, its observable's common scale, or its C/N0
-    /// deficit's floor, at most the inflation) where the channel is also judged correlated
-    /// in time; 1 otherwise, and when off.
-    ///
-    /// Choice: only a correlated channel's excess counts (see [`super::range_excess`]): an
-    /// excess that changes from epoch to epoch is averaged by the filter as the inflated R
-    /// says. With every judged excess counted, the default drive's urban canyon and the
-    /// open sky after it went from inside the 95 % bounds to below them (ekf, seed 3: the
-    /// canyon's share inside 0.78 → 0.42; docs/results.md).
-    pub fn carried_size_factor(
-        &self,
-        sat: SatId,
-        observable: Observable,
-        t_s: f64,
-        cn0_dbhz: Option<f64>,
-    ) -> f64 {
-        match self.factors(sat, observable, t_s, cn0_dbhz) {
-            Some((size, correlation, floor)) if correlation > 1.0 => {
-                size.min(self.max_inflation).max(floor)
-            }
-            _ => 1.0,
-        }
-    }
-
-    /// The channel's (variance, correlation) factors ([`Self::judged`]) and its C/N0
-    /// deficit's floor this epoch; None when off.
-    fn factors(
-        &self,
-        sat: SatId,
-        observable: Observable,
-        t_s: f64,
-        cn0_dbhz: Option<f64>,
-    ) -> Option<(f64, f64, f64)> {
+    ) -> Verdict {
         if !self.is_on() {
-            return None;
+            return Verdict {
+                inflation: 1.0,
+                carried_size: 1.0,
+            };
         }
         let floor = self
             .cn0
             .floor(sat, t_s, cn0_dbhz, self.max_gap_s, self.max_inflation);
         let (size, correlation) = self.judged(sat, observable, t_s);
-        Some((size, correlation, floor))
+        // Choice: only a correlated channel's excess is carried (see
+        // [`super::range_excess`]): an excess that changes from epoch to epoch is averaged
+        // by the filter as the inflated R says. With every judged excess counted, the
+        // default drive's urban canyon and the open sky after it went from inside the
+        // 95 % bounds to below them (ekf, seed 3: the canyon's share inside 0.78 → 0.42;
+        // docs/results.md).
+        let carried_size = if correlation > 1.0 {
+            size.min(self.max_inflation).max(floor)
+        } else {
+            1.0
+        };
+        Verdict {
+            inflation: (size * correlation).min(self.max_inflation).max(floor),
+            carried_size,
+        }
     }
 
-    /// The factors from the residuals of the epochs before (see [`Self::inflation`]):
+    /// The factors from the residuals of the epochs before (see [`Self::verdict`]):
     /// (variance, correlation).
     fn judged(&self, sat: SatId, observable: Observable, t_s: f64) -> (f64, f64) {
         let common = self
@@ -547,7 +535,11 @@ mod tests {
     ) -> Vec<f64> {
         let judge = judge_after(satellites, hph, epochs, error);
         (1..=satellites)
-            .map(|prn| judge.inflation(sat(prn), Observable::Pseudorange, epochs as f64, None))
+            .map(|prn| {
+                judge
+                    .verdict(sat(prn), Observable::Pseudorange, epochs as f64, None)
+                    .inflation
+            })
             .collect()
     }
 
@@ -612,7 +604,11 @@ mod tests {
         for k in 0..34u16 {
             let risen = if k >= 30 { 12 } else { SATELLITES };
             let inflations: Vec<f64> = (1..=risen)
-                .map(|prn| judge.inflation(sat(prn), Observable::Pseudorange, f64::from(k), None))
+                .map(|prn| {
+                    judge
+                        .verdict(sat(prn), Observable::Pseudorange, f64::from(k), None)
+                        .inflation
+                })
                 .collect();
             if k >= 30 {
                 inflation_of_the_biased.push(inflations[10]);
@@ -654,8 +650,9 @@ mod tests {
             _ => white(rng),
         });
         let t = 60.0;
-        let carried = |prn| judge.carried_size_factor(sat(prn), Observable::Pseudorange, t, None);
-        let inflation = |prn| judge.inflation(sat(prn), Observable::Pseudorange, t, None);
+        let verdict = |prn| judge.verdict(sat(prn), Observable::Pseudorange, t, None);
+        let carried = |prn| verdict(prn).carried_size;
+        let inflation = |prn| verdict(prn).inflation;
         assert!(carried(4) > 4.0, "{}", carried(4));
         assert!(inflation(6) > 4.0, "{}", inflation(6));
         assert_eq!(carried(6), 1.0);
@@ -735,7 +732,9 @@ mod tests {
                 .collect()
         };
         let at = |judge: &ErrorCorrelation, prn: u16, t_s: f64| {
-            judge.inflation(sat(prn), Observable::Pseudorange, t_s, None)
+            judge
+                .verdict(sat(prn), Observable::Pseudorange, t_s, None)
+                .inflation
         };
         for k in 0..30 {
             judge.push(k as f64, &biased(k));
@@ -788,7 +787,10 @@ mod tests {
                     .collect();
                 judge.push(k as f64, &epoch);
                 let all_inflated = (1..=SATELLITES).all(|prn| {
-                    judge.inflation(sat(prn), Observable::Pseudorange, k as f64 + 1.0, None) >= 2.0
+                    judge
+                        .verdict(sat(prn), Observable::Pseudorange, k as f64 + 1.0, None)
+                        .inflation
+                        >= 2.0
                 });
                 if k >= 40 && all_inflated {
                     met[k - 40] += 1;
@@ -796,7 +798,9 @@ mod tests {
             }
             // The rates are another observable, judged apart.
             assert_eq!(
-                judge.inflation(sat(1), Observable::PseudorangeRate, 43.0, None),
+                judge
+                    .verdict(sat(1), Observable::PseudorangeRate, 43.0, None)
+                    .inflation,
                 1.0
             );
         }

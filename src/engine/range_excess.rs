@@ -12,7 +12,7 @@
 //! Choice: the excess of a row is its variance beyond the claim, (s − 1) R with s the
 //! judge's size factor (not its correlation factor: a correlated error of the claimed size
 //! is the claimed size at each epoch), counted only where the judge also finds the
-//! channel correlated in time (`ErrorCorrelation::carried_size_factor`), weighed as the
+//! channel correlated in time (`Verdict::carried_size`), weighed as the
 //! update weighs the rows (1 / (R f), f the whole inflation). The least squares is that
 //! of the rows' common columns (position or velocity, and the clock), as the judge's
 //! parity fit; an epoch whose rows cannot fix them leaves nothing.

@@ -327,14 +327,13 @@ impl<M: MeasurementModel> Step<'_, M> {
         if !judge.is_on() {
             return (vec![1.0; channels.len()], vec![1.0; channels.len()]);
         }
-        let factors = channels
+        let (factors, sizes) = channels
             .iter()
-            .map(|c| judge.inflation(c.sat, c.observable, t_s, c.cn0_dbhz))
-            .collect();
-        let sizes = channels
-            .iter()
-            .map(|c| judge.carried_size_factor(c.sat, c.observable, t_s, c.cn0_dbhz))
-            .collect();
+            .map(|c| {
+                let verdict = judge.verdict(c.sat, c.observable, t_s, c.cn0_dbhz);
+                (verdict.inflation, verdict.carried_size)
+            })
+            .unzip();
         if self.learn {
             let epoch: Vec<ChannelInnovation> = channels
                 .iter()
