@@ -5,11 +5,10 @@
 //! (params/imu_consumer_mems.yaml) and `constraints.platform: car`, must stay within the
 //! issue's bounds: 3D RMSE below 2.7 m (KF-GINS's figure on such a drive), the largest 3D
 //! error below 30 m wherever a fix came within the last 30 s, no non-finite solution.
-//! Checked on seed 1, tightly coupled on seeds 3 and 4, loosely coupled on seeds 2 and 4
-//! and on seed 2 with the receiver's velocities (seed 2 tightly coupled meets them too,
-//! 1.2–1.7 m by hand); seed 3 loosely coupled misses them by the drift of its outages
-//! (2.2–3.8 m, docs/results.md). Seed 3 with the receiver's velocities and no constraint
-//! checks that a restart in the foliage is no less honest than no restart.
+//! Checked on seed 1, tightly coupled on seeds 3 and 4, loosely coupled on seeds 2, 3 and
+//! 4 and on seed 2 with the receiver's velocities (seed 2 tightly coupled meets them too,
+//! 1.2–1.7 m by hand). Seed 3 with the receiver's velocities and no constraint checks
+//! that a restart in the foliage is no less honest than no restart.
 //!
 //! Before `loose.fix_outlier_sigma` akf_all reached 8.6 m RMSE here (it took the canyon's
 //! outliers nearly whole) and, without the platform's constraint, the divergence monitor
@@ -152,11 +151,16 @@ const CHI2_9_Q999: f64 = 27.877;
 /// beyond the claims),
 /// and that akf_all was reset: the reset is marginal (5.06σ on the monitor's fourth
 /// epoch, where ekf stays at 4.82σ), and without one this test would not try a restart.
+/// With the fixes deweighted beyond χ²(3)'s 95 % quantile (`loose.fix_outlier_sigma` 2.8,
+/// the default since) akf_all is not reset here at all, which leaves no restart to judge:
+/// the test keeps the former 5.
 #[test]
 fn a_restart_in_foliage_is_no_less_honest_than_no_restart_with_receiver_velocities_on_seed_3() {
     let (_dir, bag) = hour_bag(3, SimulateOptions { velocity: true });
     let files: Vec<PathBuf> = LOOSE_FILES.iter().map(|f| repo(f)).collect();
-    let base = config_from_files(&files).unwrap();
+    let mut base = config_from_files(&files).unwrap();
+    base.set_parameter("loose.fix_outlier_sigma", "5.0")
+        .unwrap();
     let configs: Vec<NamedConfig> = [FilterVariant::AkfAll, FilterVariant::Ekf]
         .iter()
         .map(|&variant| NamedConfig::of_variant(&base, variant))
@@ -229,7 +233,9 @@ fn shares_beyond_q999(report: &SessionReport, environment: &str) -> (f64, f64) {
 /// (`FixConsistency::unclaimed_covariance`), on 3–14 % (the position alone 0–1 %,
 /// residual_akf's 7 %, whose judge weighs its own estimate of R rather than the claim);
 /// the rest is the velocity and the attitude, which follow the fixes' correlated errors
-/// too. Asserted: the measured shares, rounded up (an honest filter is near 0.1 %).
+/// too. With each fix deweighted beyond χ²(3)'s 95 % quantile (`loose.fix_outlier_sigma`
+/// 2.8, was 5) they follow them less: 0–3 % (akf_all 2.65 %, iarf 3.00 %), the position
+/// alone 0 %. Asserted: the measured shares, rounded up (an honest filter is near 0.1 %).
 #[test]
 fn every_variant_loosely_coupled_is_honest_in_the_foliage_on_seed_3() {
     let (_dir, bag) = hour_bag(3, SimulateOptions::default());
@@ -242,8 +248,8 @@ fn every_variant_loosely_coupled_is_honest_in_the_foliage_on_seed_3() {
             100.0 * all,
             100.0 * position
         );
-        assert!(all < 0.15, "{}: {:.2} %", row.filter, 100.0 * all);
-        assert!(position < 0.10, "{}: {:.2} %", row.filter, 100.0 * position);
+        assert!(all < 0.05, "{}: {:.2} %", row.filter, 100.0 * all);
+        assert!(position < 0.01, "{}: {:.2} %", row.filter, 100.0 * position);
     }
 }
 
@@ -297,6 +303,15 @@ fn every_variant_loosely_coupled_meets_the_hours_bounds() {
 #[test]
 fn every_variant_loosely_coupled_meets_the_hours_bounds_on_seed_2() {
     assert_the_hours_bounds(2, &LOOSE_FILES, &LOOSE_VARIANTS);
+}
+
+/// Seed 3's 60 s outage at 1500 s drifts the most. Its last fix before, 4.8σ off along
+/// the track, passed `loose.fix_outlier_sigma` when it was 5 and set the velocity 0.13 m/s
+/// and the pitch 0.05° off: 40 m at the outage's end, 2.2–3.8 m over the hour. Deweighted
+/// beyond χ²(3)'s 95 % quantile (2.8), 2.2–2.7 m (docs/results.md).
+#[test]
+fn every_variant_loosely_coupled_meets_the_hours_bounds_on_seed_3() {
+    assert_the_hours_bounds(3, &LOOSE_FILES, &LOOSE_VARIANTS);
 }
 
 #[test]

@@ -39,6 +39,11 @@ fn alarm_rate(variant: FilterVariant, confidence: f64, epochs: usize, seed: u64)
     config.filter.variant = variant;
     config.filter.coupling = Coupling::Loose;
     config.robust.chi2_confidence = confidence;
+    // The paper's filters take each fix whole. With the product's deweighting of a fix
+    // beyond χ²(3)'s 95 % quantile (`loose.fix_outlier_sigma`, 2.8) akf_partial's χ²₆ test
+    // at 95 % sees those fixes at the bound and alarmed on 2.3 % of clean epochs (mean M²
+    // 5.77): the rate then measures the deweighting, not the filter's consistency.
+    config.loose.fix_outlier_sigma = 0.0;
     let sigma_enu_m = Vector3::new(
         config.loose.fix_sigma_horizontal_m,
         config.loose.fix_sigma_horizontal_m,
