@@ -398,8 +398,9 @@ parameter_table! {
         /// A fix's position (and, on its own, its velocity) whose innovation lies beyond
         /// this Mahalanobis distance d under its innovation covariance is an outlier: its
         /// covariance is scaled by (d / this)^2, so that it pulls as one on the bound
-        /// would; counted (fix_position_outliers, fix_velocity_outliers). Not applied by
-        /// iarf, whose robust R does the same. 0 = off (the IARF paper's filters).
+        /// would; counted (fix_position_outliers, fix_velocity_outliers: at 2.8 one in
+        /// twenty of a sound receiver's fixes). Not applied by iarf, whose robust R does
+        /// the same. 0 = off (the IARF paper's filters).
         // Choice: 2.8, the 95 % quantile of χ²(3) (√7.81), the one the fix judge counts
         // beyond: a clean fix is deweighted with probability 0.05, and then by little.
         // Without it the EKF takes a street canyon's fix 350 m off most of the way. It
