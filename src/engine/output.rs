@@ -70,7 +70,7 @@ impl Solution {
     }
 
     /// Adds `covariance_enu_m2_s2` (ENU, (m/s)²) to the velocity covariance.
-    pub fn widen_velocity_by_covariance(&mut self, covariance_enu_m2_s2: &Matrix3<f64>) {
+    fn widen_velocity_by_covariance(&mut self, covariance_enu_m2_s2: &Matrix3<f64>) {
         let mut block = self.covariance.fixed_view_mut::<3, 3>(DV, DV);
         block += covariance_enu_m2_s2;
     }
